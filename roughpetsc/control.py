@@ -1,0 +1,419 @@
+"""Solvers of the contact QP under displacement and load control.
+
+* Displacement control (prescribed mean gap d): ``min 1/2 p'Kp + p'(d - h)``,
+  ``p >= 0``, by any TAO bound-constrained type (:class:`BoundQP`).
+* Load control (prescribed pbar):
+  Polonsky-Keer constrained CG as a TAO ``python`` type (:mod:`roughpetsc.pk`),
+  a safeguarded root find on d around :class:`BoundQP` (:class:`RootFind`), or
+  TAO ALMM with the equality ``mean(p) = pbar`` (:class:`ALMMLoad`).
+
+Every solver works on the scaled problem of :class:`~roughpetsc.contact.ContactProblem`,
+updates the pressure Vec it is given (the warm start) and returns an
+:class:`Outcome`; :class:`Solver` turns that into a checked
+:class:`~roughpetsc.contact.Result`.
+"""
+
+from dataclasses import dataclass
+import time
+
+import numpy as np
+from petsc4py import PETSc
+
+from .contact import Result, measure
+from .errors import UserError
+from .kkt import ConvergenceTest, History, report
+from .pk import PolonskyKeer
+
+BOUND_TYPES = ("blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bqnktl", "bnls", "bntr", "bntl", "tron", "gpcg")
+SECOND_ORDER = ("bqnkls", "bqnktr", "bqnktl", "bnls", "bntr", "bntl", "tron", "gpcg")
+DEFAULT_MAX_IT = 100000
+
+
+@dataclass
+class Outcome:
+    """What a solver reports besides the pressure it leaves in its Vec."""
+
+    separation: float
+    iterations: int
+    reason: str
+    history: np.ndarray
+
+
+def reason_name(reason):
+    """PETSc's name of a TAO converged reason."""
+    for name, value in vars(PETSc.TAO.Reason).items():
+        if not name.startswith("_") and value == reason and name not in ("ITERATING", "CONVERGED_ITERATING"):
+            return name
+    return str(reason)
+
+
+def _set_default_option(name, value):
+    options = PETSc.Options()
+    if not options.hasName(name):
+        options.setValue(name, value)
+
+
+class BoundQP:
+    """Displacement control: the bound-constrained QP at a given separation, by TAO.
+
+    Working defaults for a shell Hessian are set before ``setFromOptions`` so
+    that options override them: no gradient tolerances (the natural-residual
+    test decides), a high iteration limit (the BNK family stops at 50 by
+    default), subset type ``subvec`` and PC ``none`` for TRON and GPCG.
+    """
+
+    def __init__(self, problem, tao_type, rtol, prefix=""):
+        self.problem = problem
+        self.rtol = rtol
+        self.separation = 0.0
+        comm = problem.comm
+        self.gap_vec = problem.vec()
+        self.cached_x = problem.vec()
+        self.has_cache = False
+        self.hessian = problem.operator.mat()
+        self.lower = problem.vec()
+        self.lower.set(0.0)
+        self.upper = problem.vec()
+        self.upper.set(PETSc.INFINITY)
+        self.gradient = problem.vec()
+        tao = self.tao = PETSc.TAO().create(comm)
+        tao.setOptionsPrefix(prefix)
+        tao.setType(tao_type)
+        if tao_type in ("tron", "gpcg"):
+            _set_default_option(prefix + "tao_subset_type", "subvec")
+        tao.setObjectiveGradient(self._objective_gradient, self.gradient)
+        tao.setHessian(self._hessian, self.hessian, self.hessian)
+        tao.setVariableBounds((self.lower, self.upper))
+        tao.setTolerances(gatol=0.0, grtol=0.0, gttol=0.0)
+        tao.setMaximumIterations(DEFAULT_MAX_IT)
+        tao.setMaximumFunctionEvaluations(10 * DEFAULT_MAX_IT)
+        if tao_type in SECOND_ORDER:
+            ksp = tao.getKSP()
+            if ksp is not None and tao_type in ("tron", "gpcg"):
+                ksp.getPC().setType("none")
+        tao.setFromOptions()
+        self.tao_type = tao.getType()
+        self.history = None
+        self.target_pbar = None
+
+    def _objective_gradient(self, tao, x, gradient):
+        """f = p'Kp/2 + p'(d - h) = (p'g + d sum(p) - p'h) / 2 with the gradient g = K p + d - h."""
+        self.problem.gap(x, self.separation, gradient)
+        x.copy(self.cached_x)
+        gradient.copy(self.gap_vec)
+        self.has_cache = True
+        return 0.5 * (x.dot(gradient) + self.separation * x.sum() - x.dot(self.problem.heights))
+
+    def _hessian(self, tao, x, H, P):
+        pass
+
+    def gap_of(self, x):
+        """Gap of the iterate ``x`` (local array), reusing the objective's when ``x`` is the last evaluated."""
+        if not (self.has_cache and x.equal(self.cached_x)):
+            self.problem.gap(x, self.separation, self.gap_vec)
+            x.copy(self.cached_x)
+            self.has_cache = True
+        return self.problem.local(self.gap_vec, readonly=True)
+
+    def solve(self, separation, pressure, history=None):
+        """Solve at ``separation`` (scaled) from the start ``pressure`` (overwritten)."""
+        self.separation = separation
+        self.has_cache = False
+        history = history or History(self.problem.operator)
+        test = ConvergenceTest(self.problem.mpi, self.problem.n, self.rtol, self.gap_of, history)
+        self.tao.setConvergenceTest(test)
+        # A start outside the bounds would be projected by TAO anyway; do it here.
+        local = self.problem.local(pressure)
+        np.maximum(local, 0.0, out=local)
+        self.tao.setSolution(pressure)
+        self.tao.solve(pressure)
+        return Outcome(separation, self.tao.getIterationNumber(), reason_name(self.tao.getConvergedReason()),
+                       history.as_array())
+
+    def destroy(self):
+        self.tao.destroy()
+        for obj in (self.gap_vec, self.cached_x, self.hessian, self.lower, self.upper, self.gradient):
+            obj.destroy()
+
+
+class RootFind:
+    """Load control by a safeguarded root find on the separation around :class:`BoundQP`.
+
+    The mean pressure P(d) of the displacement-controlled solution decreases
+    from the complete-contact pressure max(-p_c) at d -> 0+ to 0 at d = max(h),
+    so [0, max h] brackets the root and no solve is needed at its ends. Brent's
+    method (scipy) narrows it; every inner solve starts from the previous
+    pressure. The search stops when |P(d) - pbar| / pbar <= rtol.
+    """
+
+    def __init__(self, problem, tao_type, rtol, max_evaluations=100):
+        self.qp = BoundQP(problem, tao_type, rtol)
+        self.problem = problem
+        self.rtol = rtol
+        self.max_evaluations = max_evaluations
+        self.tao_type = self.qp.tao_type
+
+    def solve(self, pbar, pressure, separation_guess=None):
+        from scipy.optimize import brentq
+
+        problem = self.problem
+        history = History(problem.operator)
+        state = {"iterations": 0, "evaluations": 0, "reason": "DIVERGED_MAXFCN"}
+
+        class Found(Exception):
+            pass
+
+        def excess(d):
+            if d <= 0.0:
+                return problem.complete_contact_pbar - pbar
+            if d >= problem.max_height:
+                return -pbar
+            outcome = self.qp.solve(d, pressure, history)
+            state["iterations"] += outcome.iterations
+            state["evaluations"] += 1
+            state["reason"] = outcome.reason
+            mean_p = pressure.sum() / problem.n
+            if abs(mean_p - pbar) <= self.rtol * pbar:
+                state["separation"] = d
+                raise Found
+            if state["evaluations"] >= self.max_evaluations:
+                raise Found
+            return mean_p - pbar
+
+        lower, upper = 0.0, problem.max_height
+        try:
+            if separation_guess is not None and 0.0 < separation_guess < upper:
+                value = excess(separation_guess)
+                lower, upper = (separation_guess, upper) if value > 0 else (lower, separation_guess)
+            d = brentq(excess, lower, upper, xtol=1e-15 * problem.max_height, rtol=1e-15,
+                       maxiter=self.max_evaluations)
+            state["separation"] = d
+            state["reason"] = "DIVERGED_ROOT_TOLERANCE"
+        except Found:
+            pass
+        if "separation" not in state:
+            state["separation"] = self.qp.separation
+        reason = state["reason"]
+        if state["evaluations"] >= self.max_evaluations and abs(pressure.sum() / problem.n - pbar) > self.rtol * pbar:
+            reason = "DIVERGED_ROOT_MAXFCN"
+        return Outcome(state["separation"], state["iterations"], f"{reason} ({state['evaluations']} inner solves)",
+                       history.as_array())
+
+    def destroy(self):
+        self.qp.destroy()
+
+
+class ALMMLoad:
+    """Load control by TAO ALMM: ``min 1/2 p'Kp - p'h`` with ``p >= 0`` and ``mean(p) = pbar``.
+
+    The multiplier of the equality is the separation; it is recovered from the
+    contact set as in Polonsky-Keer. The subsolver is chosen with
+    ``-tao_almm_subsolver_tao_type`` (first-order types only in PETSc 3.18).
+    """
+
+    def __init__(self, problem, rtol):
+        self.problem = problem
+        self.rtol = rtol
+        self.target = 0.0
+        comm = problem.comm
+        n_local = problem.operator.local_shape[0] * problem.operator.local_shape[1]
+        rows = 1 if comm.getRank() == 0 else 0
+        self.gradient = problem.vec()
+        self.gap_vec = problem.vec()
+        self.hessian = problem.operator.mat()
+        self.lower = problem.vec()
+        self.lower.set(0.0)
+        self.upper = problem.vec()
+        self.upper.set(PETSc.INFINITY)
+        self.constraint = PETSc.Vec().createMPI((rows, 1), comm=comm)
+        # The Jacobian of mean(p) - pbar: one dense row of 1/n, owned by rank 0.
+        self.jacobian = PETSc.Mat().createDense(((rows, 1), (n_local, problem.n)), comm=comm)
+        self.jacobian.setUp()
+        start, end = self.gradient.getOwnershipRange()
+        columns = np.arange(start, end, dtype=PETSc.IntType)
+        self.jacobian.setValues([0], columns, np.full(columns.size, 1.0 / problem.n))
+        self.jacobian.assemble()
+        tao = self.tao = PETSc.TAO().create(comm)
+        tao.setType("almm")
+        tao.setObjectiveGradient(self._objective_gradient, self.gradient)
+        tao.setHessian(lambda *args: None, self.hessian, self.hessian)
+        tao.setVariableBounds((self.lower, self.upper))
+        tao.setEqualityConstraints(self._equality, self.constraint)
+        tao.setJacobianEquality(lambda *args: None, self.jacobian, self.jacobian)
+        tao.setTolerances(gatol=0.0, grtol=0.0, gttol=0.0)
+        tao.setMaximumIterations(DEFAULT_MAX_IT)
+        tao.setFromOptions()
+        self.tao_type = "almm"
+
+    def _objective_gradient(self, tao, x, gradient):
+        problem = self.problem
+        problem.gap(x, 0.0, gradient)
+        heights_dot = x.dot(problem.heights)
+        return 0.5 * (gradient.dot(x) - heights_dot)
+
+    def _equality(self, tao, x, c):
+        c.set(x.sum() / self.problem.n - self.target)
+
+    def gap_of(self, x):
+        problem = self.problem
+        problem.operator.displacement(x, self.gap_vec)
+        displacement = problem.local(self.gap_vec)
+        d = problem.contact_separation(x, displacement)
+        displacement -= problem.local(problem.heights, readonly=True)
+        displacement += d
+        self.separation = d
+        return displacement
+
+    def solve(self, pbar, pressure):
+        self.target = pbar
+        history = History(self.problem.operator)
+        test = ConvergenceTest(self.problem.mpi, self.problem.n, self.rtol, self.gap_of, history, target_pbar=pbar)
+        self.tao.setConvergenceTest(test)
+        self.tao.setSolution(pressure)
+        self.tao.solve(pressure)
+        self.gap_of(pressure)
+        return Outcome(self.separation, self.tao.getIterationNumber(), reason_name(self.tao.getConvergedReason()),
+                       history.as_array())
+
+    def destroy(self):
+        self.tao.destroy()
+        for obj in (self.gradient, self.gap_vec, self.hessian, self.lower, self.upper, self.constraint, self.jacobian):
+            obj.destroy()
+
+
+class PKLoad:
+    """Load control by Polonsky-Keer, run as a TAO of type ``python`` (so -tao_monitor etc. work)."""
+
+    def __init__(self, problem, rtol):
+        self.problem = problem
+        self.context = PolonskyKeer(problem, rtol)
+        tao = self.tao = PETSc.TAO().create(problem.comm)
+        tao.setType(PETSc.TAO.Type.PYTHON)
+        tao.setPythonContext(self.context)
+        tao.setMaximumIterations(DEFAULT_MAX_IT)
+        tao.setFromOptions()
+        self.tao_type = "pk"
+
+    def solve(self, pbar, pressure):
+        self.context.target_pbar = pbar
+        self.tao.setSolution(pressure)
+        self.tao.solve(pressure)
+        ctx = self.context
+        return Outcome(ctx.separation, self.tao.getIterationNumber(), reason_name(self.tao.getConvergedReason()),
+                       ctx.history.as_array())
+
+    def destroy(self):
+        self.tao.destroy()
+        self.context.destroy()
+
+
+class Solver:
+    """One contact solver for a problem, chosen by options; solves loads in order with warm starts.
+
+    Parameters
+    ----------
+    problem : ContactProblem
+    control : "load" or "displacement"
+    tao_type : str or None
+        None: Polonsky-Keer under load control, BLMVM under displacement
+        control; "almm": ALMM (load control only); a bound type: that TAO type
+        (inside the root find under load control).
+    rtol : float
+        Stopping tolerance on the natural KKT residual (-kkt_rtol).
+    """
+
+    def __init__(self, problem, control, tao_type, rtol):
+        self.problem = problem
+        self.control = control
+        self.rtol = rtol
+        if tao_type in (None, "", "python", "pk"):
+            tao_type = None
+        elif tao_type == "almm":
+            if control != "load":
+                raise UserError("-tao_type almm solves load control only (use -pbar or -pstar)")
+        elif tao_type not in BOUND_TYPES:
+            raise UserError(f"-tao_type {tao_type} is not a bound-constrained TAO type for this QP; "
+                            f"use one of {', '.join(BOUND_TYPES)}, almm, or none (Polonsky-Keer)")
+        if control == "displacement":
+            self.backend = BoundQP(problem, tao_type or "blmvm", rtol)
+        elif tao_type is None:
+            self.backend = PKLoad(problem, rtol)
+        elif tao_type == "almm":
+            self.backend = ALMMLoad(problem, rtol)
+        else:
+            self.backend = RootFind(problem, tao_type, rtol)
+        self.name = self.backend.tao_type if control == "displacement" or tao_type in (None, "almm") \
+            else f"rootfind({self.backend.tao_type})"
+        self.pressure = problem.vec()
+        self.pressure.set(0.0)
+        self.gap = problem.vec()
+        self.last_separation = None
+
+    def solve(self, pbar=None, pstar=None, gbar=None):
+        """Solve one load; the previous solution is the start. Returns a :class:`Result`."""
+        problem = self.problem
+        start = time.perf_counter()
+        applications = problem.operator.applications
+        if gbar is not None:
+            if not gbar > 0:
+                raise UserError(f"-gbar must be positive (complete contact has zero mean gap), got {gbar}")
+            target = None
+            outcome = self.backend.solve(gbar / problem.height_scale, self.pressure)
+        else:
+            target = problem.scaled_pbar(pbar, pstar)
+            if not target > 0:
+                raise UserError(f"the load must be positive: -pbar/-pstar gave {pbar if pstar is None else pstar}")
+            if target >= problem.complete_contact_pbar:
+                outcome = self._complete_contact(target)
+            else:
+                self._load_start(target)
+                if isinstance(self.backend, RootFind):
+                    outcome = self.backend.solve(target, self.pressure, self.last_separation)
+                else:
+                    outcome = self.backend.solve(target, self.pressure)
+        self.last_separation = outcome.separation
+        return self._result(outcome, target, start, applications)
+
+    def _load_start(self, target):
+        """Scale the warm start to the new load (or start from a uniform pressure)."""
+        mean_p = self.pressure.sum() / self.problem.n
+        if mean_p > 0:
+            self.pressure.scale(target / mean_p)
+        else:
+            self.pressure.set(target)
+
+    def _complete_contact(self, target):
+        """Beyond complete contact the exact answer is p = pbar + p_c, g = 0 (d = 0)."""
+        self.problem.pressure_surface.copy(self.pressure)
+        self.pressure.shift(target)
+        return Outcome(0.0, 0, "COMPLETE_CONTACT_EXACT", np.zeros((0, 4)))
+
+    def _result(self, outcome, target, start, applications):
+        problem = self.problem
+        # The certificate: a fresh gap of the final pressure, whatever the solver cached.
+        problem.gap(self.pressure, outcome.separation, self.gap)
+        p = problem.local(self.pressure, readonly=True)
+        g = problem.local(self.gap, readonly=True)
+        kkt = report(problem.mpi, p, g, problem.n, target)
+        measures = measure(problem, p, g)
+        converged = kkt.natural <= self.rtol and (kkt.load_error is None or kkt.load_error <= self.rtol)
+        pbar = measures["pbar"] * problem.pressure_scale
+        gbar = measures["gbar"] * problem.height_scale
+        return Result(
+            pbar=pbar, pstar=pbar / problem.sqrt_m0p, A=measures["A"], A_corrected=measures["A_corrected"],
+            gbar=gbar, gstar=gbar / problem.sqrt_m0h, separation=outcome.separation * problem.height_scale,
+            rms_gap_contact=measures["rms_gap_contact"] * problem.height_scale, kkt=kkt,
+            iterations=outcome.iterations, operator_applications=problem.operator.applications - applications,
+            time_s=time.perf_counter() - start, reason=outcome.reason, converged=converged, solver=self.name,
+            control=self.control, history=outcome.history)
+
+    def fields(self):
+        """This rank's rows of the pressure and gap of the last solve, in pressure and length units."""
+        problem = self.problem
+        return (problem.local(self.pressure, readonly=True) * problem.pressure_scale,
+                problem.local(self.gap, readonly=True) * problem.height_scale)
+
+    def destroy(self):
+        self.backend.destroy()
+        self.pressure.destroy()
+        self.gap.destroy()

@@ -1,0 +1,133 @@
+"""KKT residuals of the contact problem (SPEC 2.4) and the TAO convergence test.
+
+All residuals are scale-free: pressures are divided by the mean pressure pbar,
+gaps by the rms height sqrt(m0^h). In the scaled variables of
+:class:`roughpetsc.contact.ContactProblem` the rms height is 1, so gaps enter
+as they are.
+"""
+
+from dataclasses import dataclass, asdict
+import time
+
+import numpy as np
+from petsc4py import PETSc
+
+
+@dataclass
+class KKTReport:
+    """The KKT report of one solve.
+
+    natural : ||min(p / pbar, g / sqrt(m0^h))||_inf, the natural residual.
+    complementarity : sum(p g) / (sum(p) sqrt(m0^h)).
+    min_p : min(p) / pbar (primal feasibility, >= 0 at a solution).
+    min_g : min(g) / sqrt(m0^h) (dual feasibility, >= 0 at a solution).
+    load_error : |mean(p) - pbar| / pbar under load control, None under displacement control.
+    """
+
+    natural: float
+    complementarity: float
+    min_p: float
+    min_g: float
+    load_error: float = None
+
+    def as_dict(self):
+        return asdict(self)
+
+
+def allsum(comm, values):
+    """Global sums of a sequence of local floats in one reduction (mpi4py communicator)."""
+    local = np.asarray(values, dtype=np.float64)
+    if comm.Get_size() == 1:
+        return local
+    from mpi4py import MPI
+
+    total = np.empty_like(local)
+    comm.Allreduce(local, total, op=MPI.SUM)
+    return total
+
+
+def allmin(comm, values):
+    """Global minima of a sequence of local floats."""
+    local = np.asarray(values, dtype=np.float64)
+    if comm.Get_size() == 1:
+        return local
+    from mpi4py import MPI
+
+    total = np.empty_like(local)
+    comm.Allreduce(local, total, op=MPI.MIN)
+    return total
+
+
+def report(comm, pressure, gap, n_total, target_pbar=None):
+    """KKT report of local arrays ``pressure``, ``gap`` (scaled units, rms height 1).
+
+    ``target_pbar`` is the prescribed mean pressure under load control (None
+    under displacement control, where the solution's own mean is used).
+    """
+    pressure, gap = pressure.ravel(), gap.ravel()
+    sum_p, sum_pg = allsum(comm, [pressure.sum(), np.dot(pressure, gap)])
+    mean_p = sum_p / n_total
+    scale = target_pbar if target_pbar else (mean_p if mean_p > 0 else 1.0)
+    natural = allmin(comm, [-np.abs(np.minimum(pressure / scale, gap)).max(initial=0.0)])[0]
+    min_p, min_g = allmin(comm, [pressure.min(initial=np.inf), gap.min(initial=np.inf)])
+    return KKTReport(
+        natural=float(-natural),
+        complementarity=float(sum_pg / sum_p) if sum_p > 0 else 0.0,
+        min_p=float(min_p / scale),
+        min_g=float(min_g),
+        load_error=None if target_pbar is None else float(abs(mean_p - target_pbar) / target_pbar),
+    )
+
+
+class History:
+    """Residual history of one solve: iteration, natural residual, operator applications, seconds."""
+
+    def __init__(self, operator):
+        self.operator = operator
+        self.start = time.perf_counter()
+        self.rows = []
+
+    def record(self, iteration, natural):
+        self.rows.append((iteration, natural, self.operator.applications, time.perf_counter() - self.start))
+
+    def as_array(self):
+        return np.array(self.rows, dtype=np.float64).reshape(-1, 4)
+
+
+class ConvergenceTest:
+    """TAO convergence test on the natural KKT residual (``tao.setConvergenceTest``).
+
+    TAO's default test runs first (petsc4py calls it before this one); with its
+    gradient tolerances set to zero it only stops on iteration/evaluation
+    limits or a failed line search. This test declares convergence when the
+    natural residual of the current iterate is at most ``rtol``; a default
+    "converged" verdict reached with a larger residual is turned back into
+    "continue" while iterations remain, so TAO's own residual measure (which
+    differs by type) never ends a solve early.
+
+    ``gap_of(x)`` returns the local gap array of the iterate ``x`` (cached by
+    the objective when possible), ``pbar_of(x)`` the normalising pressure.
+    """
+
+    def __init__(self, comm, n_total, rtol, gap_of, history, target_pbar=None, pressure_of=None):
+        self.comm = comm
+        self.n_total = n_total
+        self.rtol = rtol
+        self.gap_of = gap_of
+        self.history = history
+        self.target_pbar = target_pbar
+        self.pressure_of = pressure_of or (lambda x: x.getArray(readonly=True))
+        self.last = None
+
+    def __call__(self, tao):
+        x = tao.getSolution()
+        kkt = report(self.comm, self.pressure_of(x), self.gap_of(x), self.n_total, self.target_pbar)
+        self.last = kkt
+        iteration = tao.getIterationNumber()
+        self.history.record(iteration, kkt.natural)
+        load_ok = kkt.load_error is None or kkt.load_error <= self.rtol
+        if kkt.natural <= self.rtol and load_ok:
+            return PETSc.TAO.Reason.CONVERGED_USER
+        if tao.getConvergedReason() > 0 and iteration < tao.getMaximumIterations():
+            return PETSc.TAO.Reason.CONTINUE_ITERATING
+        return None

@@ -1,0 +1,305 @@
+"""Penny-shaped adhesive crack and the adhesive adapted GW model (seed chapter 6).
+
+Dimensionless groups of Eqs. (6.4)-(6.6): ``p* = p0 / P``, ``b* = b / L``,
+``m = c / b``, ``G* = G / w``, ``A* = A / L^2``, ``V* = V / (3 w / (2 kappa))``,
+``sigma0* = sigma0 / P`` with ``P = (pi^2 E*^2 w^2 kappa / 72)^(1/5)`` and
+``L = (81 pi E* w / (16 kappa^2))^(1/5)``.
+
+Maugis-Dugdale solution set.  Eliminating p* between (6.28) and (6.29) gives,
+with s = sqrt(1 - m^2),
+
+    s^3 b^3 + sigma0 m (1 - m) b - 1/sigma0 = 0,    p = 3/2 b^2 + sigma0 s,
+
+whose positive root b(m) is unique for every m in [0, 1): the whole solution
+set is one curve parametrised by m, from F (m = 0, (6.39)) to the JKR-like end
+A (m -> 1, b -> inf).  Its minimum in p* is the snap-in point B; the stable
+branch is the part beyond B (checked against (6.31) in the tests).
+
+Trapped volume: integrating the crack opening (6.24) over the crack gives
+V* = 2 pi b^3 [p - 9/10 b^2 - sigma0 (1 - m^2)^(3/2)] in closed form (the
+adhesive term is int_c^b 2 pi t sqrt(t^2 - c^2) dt); the printed (6.33)/(6.35)
+differ from it (see the study notes).
+"""
+
+import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+
+from . import pdfs
+from .quadrature import gauss_legendre, semi_infinite
+
+__all__ = ["jkr_pstar", "jkr_pmin", "jkr_radius", "jkr_G", "jkr_volume",
+           "nonadhesive_radius", "nonadhesive_area", "nonadhesive_volume",
+           "AdhesiveCrack", "AdhesiveGW"]
+
+
+# --------------------------------------------------------------------- limits
+def nonadhesive_radius(p):
+    """b* = sqrt(2 p* / 3), Eq. (6.8)."""
+    return np.sqrt(2.0 * np.maximum(np.asarray(p, float), 0.0) / 3.0)
+
+
+def nonadhesive_area(p):
+    """A* = 2 pi p* / 3, Eq. (6.9)."""
+    return 2.0 * np.pi / 3.0 * np.maximum(np.asarray(p, float), 0.0)
+
+
+def nonadhesive_volume(p):
+    """V* = (8 sqrt 6 / 45) pi p*^(5/2): (5.28) in the groups (6.4)-(6.5).
+
+    (The printed (6.10), 16 sqrt3/45 pi p*^(5/2), is larger by sqrt 2 and
+    disagrees with (5.28) and with (6.21) at sigma0* = 0.)"""
+    return 8.0 * np.sqrt(6.0) / 45.0 * np.pi * np.maximum(np.asarray(p, float), 0.0) ** 2.5
+
+
+def jkr_pstar(b):
+    """JKR-limit load of a crack of radius b*, Eq. (6.14)."""
+    b = np.asarray(b, float)
+    return 1.5 * b ** 2 + np.sqrt(2.0 / b)
+
+
+def jkr_pmin():
+    """Minimum p* of the JKR limit, Eq. (6.15) (about 2.3602)."""
+    r = np.sqrt(2.0) / 6.0
+    return 1.5 * r ** 0.8 + np.sqrt(2.0) * r ** -0.2
+
+
+def jkr_radius(p, branch="stable"):
+    """Crack radius b* of the JKR limit at p* (roots of 3/2 t^5 - p t + sqrt 2 = 0,
+    t = sqrt b*).  ``branch="stable"`` gives the larger root (6.17), "unstable"
+    the smaller; NaN below p*_min."""
+    p = np.atleast_1d(np.asarray(p, float))
+    bmin = (np.sqrt(2.0) / 6.0) ** 0.4           # argmin of (6.14)
+    out = np.full(p.shape, np.nan)
+    for i, pi in enumerate(p):
+        if pi < jkr_pmin():
+            continue
+        f = lambda b: jkr_pstar(b) - pi
+        if branch == "stable":
+            hi = max(2 * bmin, np.sqrt(pi))
+            out[i] = bmin if f(bmin) >= 0 else brentq(f, bmin, hi, xtol=1e-15, rtol=1e-15)
+        else:
+            out[i] = bmin if f(bmin) >= 0 else brentq(f, min(1e-12, 2.0 / pi ** 2), bmin,
+                                                      xtol=1e-16, rtol=1e-15)
+    return out
+
+
+def jkr_G(b, p):
+    """Energy release rate G* of the JKR limit, Eq. (6.16)."""
+    return b / 8.0 * (2.0 * p - 3.0 * b ** 2) ** 2
+
+
+def jkr_volume(b, p):
+    """Trapped volume V* of the JKR limit, Eq. (6.21)."""
+    return 2.0 * np.pi * b ** 3 * (p - 0.9 * b ** 2)
+
+
+# ------------------------------------------------------------ Maugis-Dugdale
+class AdhesiveCrack:
+    """Maugis-Dugdale penny-shaped adhesive crack for one sigma0* (6.22)-(6.39).
+
+    Attributes
+    ----------
+    points : dict
+        ``{"B", "C", "E", "F", "G"}`` -> (p*, b*, m) of Figs. 6.2-6.3.
+    """
+
+    Q_MAX = 60.0          # m = 1 - exp(-q), q in [0, Q_MAX]
+
+    def __init__(self, sigma0):
+        if not sigma0 > 0:
+            raise ValueError("sigma0* must be positive")
+        self.sigma = float(sigma0)
+        q = np.linspace(0.0, self.Q_MAX, 6001)
+        p = self.p_of_q(q)
+        i = int(np.argmin(p))
+        if i == 0:
+            qB = 0.0
+        else:
+            lo, hi = q[max(i - 1, 0)], q[min(i + 1, q.size - 1)]
+            qB = minimize_scalar(self.p_of_q, bounds=(lo, hi), method="bounded",
+                                 options={"xatol": 1e-13}).x
+        self.qB = qB
+        s = self.sigma
+        pB, bB, mB = self.p_of_q(qB), self.b_of_q(qB), self.m_of_q(qB)
+        pF, bF = s + 1.5 * s ** (-2.0 / 3.0), s ** (-1.0 / 3.0)            # (6.39)
+        bC = 0.0 if pB <= s else float(nonadhesive_radius(pB - s))         # closure or (6.36)
+        qG = self._stable_q(np.array([pF]))[0]
+        self.points = {"B": (pB, bB, mB), "C": (pB, bC, 0.0), "E": (s, 0.0, 0.0),
+                       "F": (pF, bF, 0.0), "G": (pF, self.b_of_q(qG), self.m_of_q(qG))}
+
+    # curve parametrisation --------------------------------------------------
+    @staticmethod
+    def m_of_q(q):
+        return -np.expm1(-np.asarray(q, float))
+
+    def b_of_q(self, q):
+        """Unique positive root b*(m) of s^3 b^3 + sigma m (1-m) b - 1/sigma = 0."""
+        m = self.m_of_q(q)
+        s3 = (1.0 - m * m) ** 1.5
+        P = self.sigma * m * np.exp(-np.asarray(q, float))       # sigma m (1 - m)
+        Q = 1.0 / self.sigma
+        with np.errstate(divide="ignore"):
+            b = np.minimum(np.cbrt(Q / s3), np.where(P > 0, Q / np.where(P > 0, P, 1), np.inf))
+        for _ in range(200):                                     # monotone Newton from above
+            f = s3 * b ** 3 + P * b - Q
+            step = f / (3 * s3 * b ** 2 + P)
+            b = b - step
+            if np.all(np.abs(step) <= 1e-15 * b):
+                break
+        return b
+
+    def p_of_q(self, q):
+        m = self.m_of_q(q)
+        return 1.5 * self.b_of_q(q) ** 2 + self.sigma * np.sqrt(1.0 - m * m)
+
+    def _stable_q(self, p):
+        """q on the stable branch (q >= qB) with p*(q) = p (vectorised bisection)."""
+        lo = np.full(p.shape, self.qB)
+        hi = np.full(p.shape, self.Q_MAX)
+        for _ in range(100):
+            mid = 0.5 * (lo + hi)
+            below = self.p_of_q(mid) < p
+            lo = np.where(below, mid, lo)
+            hi = np.where(below, hi, mid)
+        return 0.5 * (lo + hi)
+
+    def curve(self, n=2001):
+        """The whole Maugis-Dugdale solution curve: (p*, b*, m), from F to A."""
+        q = np.linspace(0.0, 25.0, n)
+        return self.p_of_q(q), self.b_of_q(q), self.m_of_q(q)
+
+    # equilibrium quantities -----------------------------------------------------
+    def stable(self, p):
+        """(b*, m) on the stable Maugis-Dugdale branch at p* >= p*_B (NaN below)."""
+        p = np.atleast_1d(np.asarray(p, float))
+        q = self._stable_q(p)
+        ok = p >= self.points["B"][0]
+        return np.where(ok, self.b_of_q(q), np.nan), np.where(ok, self.m_of_q(q), np.nan)
+
+    def state(self, p, p_min=None):
+        """Crack radius and m after a load history (Figs. 6.2-6.3).
+
+        Parameters
+        ----------
+        p : array_like
+            Current p*.
+        p_min : array_like, optional
+            Smallest p* reached so far (default: ``p``, i.e. loading).  Loading
+            (p* decreasing): stable branch down to B, then closure (p_B <= sigma0*)
+            or the full-adhesion branch (6.36) down to E.  Unloading after
+            ``p_min < p_B``: closed below E (6.38), full adhesion from E to F
+            (6.39), jump to G and the stable branch beyond.
+
+        Returns
+        -------
+        b, m : ndarray
+        """
+        p = np.atleast_1d(np.asarray(p, float))
+        pm = p if p_min is None else np.minimum(np.atleast_1d(np.asarray(p_min, float)), p)
+        pB, pF, s = self.points["B"][0], self.points["F"][0], self.sigma
+        b_md, m_md = self.stable(np.maximum(p, pB))
+        reversible = (pm >= pB) | (p >= pF)
+        full = (~reversible) & (p >= s)
+        b = np.where(reversible, b_md, np.where(full, nonadhesive_radius(p - s), 0.0))
+        m = np.where(reversible, m_md, 0.0)
+        return b, m
+
+    def area(self, b):
+        """A* = pi b*^2, Eq. (6.18)."""
+        return np.pi * np.asarray(b) ** 2
+
+    def volume(self, p, b, m):
+        """Trapped volume V* of (6.24) integrated in closed form (see module doc)."""
+        return 2.0 * np.pi * b ** 3 * (p - 0.9 * b ** 2 - self.sigma * (1.0 - m * m) ** 1.5)
+
+    def G(self, p, b, m):
+        """Energy release rate G*, Eq. (6.30)."""
+        s = np.sqrt(1.0 - m * m)
+        return (self.sigma * (p * s - (1 - m) * self.sigma) * b
+                - 0.5 * self.sigma * s * (2 * m * m + 1) * b ** 3)
+
+    def dG_db(self, p, b, m):
+        """Fixed-load derivative dG*/db*, Eqs. (6.31)-(6.32); <= 0 means stable."""
+        sg = self.sigma
+        s = np.sqrt(1.0 - m * m)
+        dm = 3 * b / (m * sg ** 2) * (p - 1.5 * b ** 2)
+        return (sg * (p * s - (1 - m) * sg) + sg * b * (sg - p * m / s) * dm
+                - 1.5 * sg * s * (2 * m * m + 1) * b ** 2
+                + 0.5 * sg * m / s * dm * (2 * m * m + 1) * b ** 3
+                - 2 * sg * m * s * b ** 3 * dm)
+
+
+# -------------------------------------------------------- adhesive GW model
+class AdhesiveGW:
+    """Adhesive adapted GW model of nearly complete contact, Eqs. (6.40)-(6.54).
+
+    Parameters
+    ----------
+    m0h, m2h, m4h, m6h : float
+        Spectral moments of the surface [length^2], [-], [1/length^2], [1/length^4].
+    sigma0_over_E : float
+        Dugdale stress over E* [-].
+    z0 : float
+        Range of adhesion [length]; the surface energy is w = sigma0 z0
+        (the convention that gives (6.56)).
+
+    All results are dimensionless: p* = pbar/sqrt(m0^p), g* = gbar/sqrt(m0^h).
+    """
+
+    def __init__(self, m0h, m2h, m4h, m6h, sigma0_over_E, z0, n_elements=16):
+        if min(m0h, m2h, m4h, m6h, sigma0_over_E, z0) <= 0:
+            raise ValueError("moments, sigma0/E* and z0 must be positive")
+        self.m0h = m0h
+        self.m0p, self.m2p, self.m4p = m2h / 2.0, m4h / 3.0, 0.3 * m6h        # (2.53), over E*^2
+        self.alpha_p = self.m0p * self.m4p / self.m2p ** 2                    # (2.54)
+        pdfs.c1(self.alpha_p)
+        w = sigma0_over_E * z0                                                # E* = 1 units
+        self.kappa = 8.0 / 3.0 * np.sqrt(self.m4p / np.pi)                     # (6.43)
+        self.eta = self.m4p / (6.0 * np.sqrt(3.0) * np.pi * self.m2p)          # (6.42)
+        Pscale = (np.pi ** 2 * w ** 2 * self.kappa / 72.0) ** 0.2             # (6.4)
+        Lscale = (81.0 * np.pi * w / (16.0 * self.kappa ** 2)) ** 0.2
+        self.sigma_star = sigma0_over_E / Pscale                              # (6.6)
+        self.C = np.sqrt(self.m0p) / Pscale                                   # (6.45)
+        self.C1 = self.eta * Lscale ** 2                                      # (6.48)
+        self.C2 = self.eta / np.sqrt(m0h) * 1.5 * w / self.kappa              # (6.49)
+        self.crack = AdhesiveCrack(self.sigma_star)
+        self.n_elements = n_elements
+
+    def _integrate(self, pbar, pbar_max):
+        """1 - A* and g* at pbar after a loading history that reached pbar_max >= pbar."""
+        c = self.crack
+        breaks = sorted({c.points["B"][0], c.sigma, c.points["F"][0]})
+        # local p* = (xi - pbar) C; history minimum (xi - pbar_max) C
+        shift = pbar - pbar_max            # <= 0 : p_min = p + shift C
+        edges = [0.0] + [bk for bk in breaks if bk > 0] + \
+                [bk - shift * self.C for bk in breaks if bk - shift * self.C > 0]
+        edges = np.unique(np.array(edges))
+        nodes, weights = [], []
+        for a, b in zip(edges[:-1], edges[1:]):
+            x, w = gauss_legendre(self.n_elements, 8, a, b)
+            nodes.append(x)
+            weights.append(w)
+        t, w = semi_infinite(self.n_elements, 8, scale=self.C, power=2)
+        nodes.append(edges[-1] + t)
+        weights.append(w)
+        pl = np.concatenate(nodes)
+        wl = np.concatenate(weights) / self.C        # d xi = d p / C
+        b, m = c.state(pl, np.maximum(pl + shift * self.C, 0.0))
+        phi = pdfs.phi_xi(pbar + pl / self.C, self.alpha_p)
+        one_minus_A = self.C1 * np.sum(wl * c.area(b) * phi)                   # (6.46)
+        g = self.C2 * np.sum(wl * c.volume(pl, b, m) * phi)                    # (6.47)
+        return one_minus_A, g
+
+    def loading(self, pstar):
+        """(A*, g*) along a monotone loading path, Eqs. (6.50)-(6.51)."""
+        p = np.atleast_1d(np.asarray(pstar, float))
+        out = np.array([self._integrate(pi, pi) for pi in p])
+        return 1.0 - out[:, 0], out[:, 1]
+
+    def unloading(self, pstar, pstar_max):
+        """(A*, g*) when unloading from pstar_max down to pstar, Eqs. (6.53)-(6.54)."""
+        p = np.atleast_1d(np.asarray(pstar, float))
+        if np.any(p > pstar_max):
+            raise ValueError("unloading p* must not exceed pstar_max")
+        out = np.array([self._integrate(pi, pstar_max) for pi in p])
+        return 1.0 - out[:, 0], out[:, 1]

@@ -1,0 +1,46 @@
+"""Eccentricity of elliptical contacts and cracks from a curvature ratio.
+
+Shared by the Hertz elliptical contact (4.10)-(4.11) and the elliptical crack
+(5.15)-(5.16): both give the curvature ratio ``y = kappa_1/kappa_2`` (0 < y <= 1)
+as an explicit, monotone function of the eccentricity ``e``; the inverse is found
+by a vectorised bisection in ``z = ln(1 - e^2)``.
+"""
+
+import numpy as np
+from scipy.special import ellipe, ellipkm1
+
+__all__ = ["elliptic_KE", "invert_ratio", "fit_sqrt1me2"]
+
+
+def elliptic_KE(z):
+    """Complete elliptic integrals K(e), E(e) for ``1 - e^2 = exp(z)`` (z <= 0).
+
+    ``ellipkm1`` keeps K accurate as e -> 1 (scipy uses the parameter m = e^2)."""
+    p = np.exp(z)                      # 1 - e^2
+    return ellipkm1(p), ellipe(1.0 - p), p
+
+
+def invert_ratio(ratio_of_z, ratio, z_min=-80.0, iterations=80):
+    """Solve ``ratio_of_z(z) = ratio`` for z = ln(1 - e^2) by vectorised bisection.
+
+    ``ratio_of_z`` must increase from 0 (z -> -inf) to 1 (z = 0).  Returns e."""
+    ratio = np.asarray(ratio, dtype=float)
+    if np.any((ratio <= 0) | (ratio > 1)):
+        raise ValueError("curvature ratio kappa_1/kappa_2 must lie in (0, 1]")
+    lo = np.full(ratio.shape, z_min)
+    hi = np.zeros(ratio.shape)
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        below = ratio_of_z(mid) < ratio
+        lo = np.where(below, mid, lo)
+        hi = np.where(below, hi, mid)
+    z = 0.5 * (lo + hi)
+    e = np.sqrt(-np.expm1(z))
+    return np.where(ratio == 1.0, 0.0, e)
+
+
+def fit_sqrt1me2(ratio, c2, c1):
+    """Empirical fits (4.11)/(5.16): sqrt(1 - e^2) = exp(c2 ln^2 y + c1 ln y); returns e."""
+    ly = np.log(np.asarray(ratio, dtype=float))
+    s = np.exp(c2 * ly ** 2 + c1 * ly)
+    return np.sqrt(np.clip(1.0 - s ** 2, 0.0, 1.0))

@@ -1,0 +1,76 @@
+"""Persson's model (seed 5.4 and appendix E)."""
+
+import numpy as np
+from scipy.special import erf, exp1
+
+from .quadrature import gauss_legendre
+
+__all__ = ["persson_area", "persson_gap", "psd_amplitude", "fractal_moments"]
+
+
+def persson_area(pstar):
+    """Contact ratio A* = 1 - erfc(p*/sqrt 2) = erf(p*/sqrt 2), Eq. (5.59);
+    p* = pbar / sqrt(m0^p)."""
+    return erf(np.asarray(pstar, dtype=float) / np.sqrt(2.0))
+
+
+def psd_amplitude(k_l, k_s, H, m2):
+    """PSD amplitude C of (2.18) with k_r = k_l from the slope moment m2, Eq. (7.1):
+    C = 4 (1 - H) m2 / ((2 pi)^3 (k_s^(2-2H) - k_l^(2-2H)))  [length^(4-2H)]."""
+    return 4.0 * (1.0 - H) * m2 / ((2.0 * np.pi) ** 3 * (k_s ** (2 - 2 * H) - k_l ** (2 - 2 * H)))
+
+
+def fractal_moments(k_l, k_s, H, C):
+    """Moments m0, m2, m4, m6 of the PSD (2.18) with k_r = k_l, Eq. (2.20)."""
+    out = []
+    coef = 1.0
+    for n in (0, 2, 4, 6):
+        if n:
+            coef *= (n - 1.0) / n
+        out.append(coef * (2 * np.pi) ** (n + 1) * C / (n - 2 * H)
+                   * (k_s ** (n - 2 * H) - k_l ** (n - 2 * H)))
+    return tuple(out)
+
+
+def persson_gap(pstar, k_l, k_s, H, m2, E_star, gamma=1.0, n_elements=64, order=8):
+    """Persson's mean interfacial gap, appendix E, Eq. (E.7) (k from k_l to k_s).
+
+    The inner pressure integral is exact, int_p^inf exp(-p'^2/(2 m0p(k))) dp'/p'
+    = E1(p^2 / (2 m0p(k))) / 2; the wavenumber integral uses the shared
+    Gauss-Legendre rule in ln k.
+
+    Parameters
+    ----------
+    pstar : array_like
+        p* = pbar / sqrt(m0^p) > 0 with m0^p = E*^2 m2 / 2 (2.53).
+    k_l, k_s : float
+        Cut-off wavenumbers [1/length] (cycles per length), 0 < k_l < k_s.
+    H : float
+        Hurst exponent, 0 < H < 1.
+    m2 : float
+        Slope moment m2^h [-] of the whole spectrum (fixes C by (7.1)).
+    E_star : float
+        Composite modulus [pressure] (g* does not depend on it).
+    gamma : float
+        Persson's energy factor of (E.2).
+    n_elements, order : int
+        Gauss-Legendre elements / points in ln k.
+
+    Returns
+    -------
+    gstar : ndarray
+        g* = gbar / sqrt(m0^h) [-].
+    """
+    p = np.atleast_1d(np.asarray(pstar, dtype=float))
+    if np.any(~(p > 0)) or not (0 < k_l < k_s) or not (0 < H < 1) or not (m2 > 0) or not (E_star > 0):
+        raise ValueError("persson_gap needs p* > 0, 0 < k_l < k_s, 0 < H < 1, m2 > 0, E* > 0")
+    C = psd_amplitude(k_l, k_s, H, m2)
+    m0h = fractal_moments(k_l, k_s, H, C)[0]
+    pbar = p * E_star * np.sqrt(m2 / 2.0)
+    s, w = gauss_legendre(n_elements, order, np.log(k_l), np.log(k_s))
+    k = np.exp(s)
+    m0p = E_star ** 2 / 8.0 * (2 * np.pi) ** 3 * C / (1.0 - H) * (k ** (2 - 2 * H) - k_l ** (2 - 2 * H))  # (E.4)
+    S = C * k ** (-2.0 * (1.0 + H))
+    inner = 0.5 * exp1(pbar[:, None] ** 2 / (2.0 * m0p[None, :]))
+    integrand = k ** 2 * S * 2.0 / np.sqrt(2.0 * np.pi * m0p) * inner * k        # dk = k ds
+    return E_star * np.pi ** 2 * gamma / np.sqrt(m0h) * np.sum(w * integrand, axis=1)

@@ -1,0 +1,254 @@
+"""Periodic surfaces on a uniform grid: generated, deterministic and measured.
+
+Array layout: a surface is a real array of shape ``(n0, n1)``; axis 0 ("rows",
+``y``) is the one distributed over MPI ranks, axis 1 (``x``) is contiguous.
+Heights are returned with zero mean (SPEC section 1). Wavenumbers are in cycles
+per length, as in the Fourier pair (2.1)/(2.2) of the seed.
+"""
+
+from dataclasses import dataclass
+import os
+
+import numpy as np
+
+from .errors import UserError
+
+
+@dataclass(frozen=True)
+class Grid:
+    """A periodic cell of ``n0 x n1`` nodes and size ``l0 x l1`` (length units)."""
+
+    n0: int
+    n1: int
+    l0: float = 1.0
+    l1: float = 1.0
+
+    @property
+    def shape(self):
+        return (self.n0, self.n1)
+
+    @property
+    def size(self):
+        return self.n0 * self.n1
+
+    @property
+    def area(self):
+        return self.l0 * self.l1
+
+    def coordinates(self):
+        """Node coordinates ``(y, x)`` as broadcastable column and row arrays."""
+        y = np.arange(self.n0)[:, None] * (self.l0 / self.n0)
+        x = np.arange(self.n1)[None, :] * (self.l1 / self.n1)
+        return y, x
+
+    def rfft_wavenumbers(self, rows=slice(None)):
+        """Wavenumbers (k0, k1) in cycles/length of the ``rfft2`` layout.
+
+        ``k0`` has shape ``(m, 1)`` for the selected rows of the full frequency
+        axis 0 and ``k1`` has shape ``(1, n1 // 2 + 1)``.
+        """
+        k0 = np.fft.fftfreq(self.n0, d=self.l0 / self.n0)[rows][:, None]
+        k1 = np.fft.rfftfreq(self.n1, d=self.l1 / self.n1)[None, :]
+        return k0, k1
+
+
+def fractal_amplitude(k_l, k_s, hurst, m2):
+    """PSD amplitude C of (2.18) with k_r = k_l from a prescribed m2^h, eq. (7.1)."""
+    return 4.0 * (1.0 - hurst) * m2 / ((2.0 * np.pi) ** 3 * (k_s ** (2 - 2 * hurst) - k_l ** (2 - 2 * hurst)))
+
+
+def fractal_psd(k, k_l, k_s, hurst, amplitude):
+    """Isotropic self-affine PSD (2.18) with k_r = k_l: C k^-2(1+H) on [k_l, k_s], else 0."""
+    k = np.asarray(k, dtype=float)
+    inside = (k >= k_l) & (k <= k_s)
+    psd = np.zeros_like(k)
+    psd[inside] = amplitude * k[inside] ** (-2.0 * (1.0 + hurst))
+    return psd
+
+
+def check_fractal_parameters(grid, k_l, k_s, hurst, m2):
+    """Raise :class:`UserError` naming the option for an impossible PSD."""
+    nyquist = min(grid.n0 / grid.l0, grid.n1 / grid.l1) / 2.0
+    if not 0.0 < hurst < 1.0:
+        raise UserError(f"-surface_H must lie in (0, 1), got {hurst}")
+    if not m2 > 0.0:
+        raise UserError(f"-surface_m2 must be positive, got {m2}")
+    if not 0.0 < k_l < k_s:
+        raise UserError(f"need 0 < -surface_kl < -surface_ks, got kl={k_l}, ks={k_s}")
+    if k_s > nyquist:
+        raise UserError(f"-surface_ks={k_s} exceeds the Nyquist wavenumber {nyquist} of the grid")
+    if k_l < 1.0 / max(grid.l0, grid.l1):
+        raise UserError(f"-surface_kl={k_l} is below the fundamental wavenumber of the cell")
+
+
+def fractal(grid, k_l, k_s, hurst, m2, seed):
+    """Gaussian isotropic self-affine surface of section 7.1.
+
+    White Gaussian noise (unit variance, one sample per node, drawn from
+    ``numpy.random.default_rng(seed)``) is filtered in Fourier space by
+    ``sqrt(S(k) n0 n1 / A0)`` so that the expected discrete spectrum equals the
+    PSD (2.18) (with k_r = k_l and C from (7.1)); the Hermitian symmetry (7.5)
+    holds because the noise is real. The result is the same array on every MPI
+    rank: each rank computes the whole surface and keeps its rows.
+
+    Returns
+    -------
+    ndarray, shape (n0, n1): heights with zero mean, length units.
+    """
+    check_fractal_parameters(grid, k_l, k_s, hurst, m2)
+    amplitude = fractal_amplitude(k_l, k_s, hurst, m2)
+    noise = np.random.default_rng(seed).standard_normal(grid.shape)
+    spectrum = np.fft.rfft2(noise)
+    del noise
+    k0, k1 = grid.rfft_wavenumbers()
+    k = np.hypot(k0, k1)
+    spectrum *= np.sqrt(fractal_psd(k, k_l, k_s, hurst, amplitude) * grid.size / grid.area)
+    spectrum[0, 0] = 0.0
+    return np.fft.irfft2(spectrum, s=grid.shape)
+
+
+def bisinusoid(grid, amplitude, wavelength0, wavelength1):
+    """Bisinusoidal waviness (3.52): Delta cos(2 pi y / lambda_y) cos(2 pi x / lambda_x)."""
+    y, x = grid.coordinates()
+    return amplitude * np.cos(2 * np.pi * y / wavelength0) * np.cos(2 * np.pi * x / wavelength1)
+
+
+def wave(grid, amplitude, wavelength):
+    """One-dimensional wave along axis 1 (Westergaard's problem), zero mean.
+
+    The profile ``2 h sin^2(pi x / lambda)`` less its mean ``h``, i.e.
+    ``-h cos(2 pi x / lambda)`` with ``h`` = ``amplitude``. Its complete-contact
+    pressure is ``p_star = pi E* h / lambda`` (Johnson, Contact Mechanics, 13.2).
+    """
+    _, x = grid.coordinates()
+    return np.broadcast_to(-amplitude * np.cos(2 * np.pi * x / wavelength), grid.shape).copy()
+
+
+def hertz_sphere(grid, radius):
+    """A paraboloid cap ``-r^2 / (2 R)`` centred in the cell, zero mean (a sphere in a large cell)."""
+    y, x = grid.coordinates()
+    r2 = (y - grid.l0 / 2) ** 2 + (x - grid.l1 / 2) ** 2
+    heights = -r2 / (2.0 * radius)
+    return heights - heights.mean()
+
+
+def load(path):
+    """Read a measured surface from ``.npy``, HDF5 (dataset ``surface``) or a text matrix.
+
+    Raises :class:`UserError` naming the file if it is missing, unreadable or
+    not a finite 2-D array. The mean is not removed here (see :func:`validate`).
+    """
+    if not os.path.isfile(path):
+        raise UserError(f"-surface_file: no such file: {path}")
+    suffix = os.path.splitext(path)[1].lower()
+    try:
+        if suffix == ".npy":
+            heights = np.load(path, allow_pickle=False)
+        elif suffix in (".h5", ".hdf5", ".hdf"):
+            import h5py
+
+            with h5py.File(path, "r") as f:
+                if "surface" not in f:
+                    raise UserError(f"-surface_file {path}: no dataset 'surface' in the HDF5 file")
+                heights = f["surface"][()]
+        else:
+            heights = np.loadtxt(path, ndmin=2)
+    except UserError:
+        raise
+    except Exception as exc:  # any reader failure is the file's fault
+        raise UserError(f"-surface_file {path}: cannot read it ({type(exc).__name__}: {exc})") from None
+    return validate(heights, f"-surface_file {path}")
+
+
+def validate(heights, source):
+    """Check a height array and return it as float64 with zero mean.
+
+    ``source`` names the option or file in the error message.
+    """
+    heights = np.asarray(heights)
+    if heights.ndim != 2 or min(heights.shape) < 2:
+        raise UserError(f"{source}: a surface must be a 2-D array with at least 2x2 nodes, got shape {heights.shape}")
+    if not np.issubdtype(heights.dtype, np.number) or np.iscomplexobj(heights):
+        raise UserError(f"{source}: heights must be real numbers, got dtype {heights.dtype}")
+    heights = heights.astype(np.float64)
+    bad = ~np.isfinite(heights)
+    if bad.any():
+        raise UserError(f"{source}: {int(bad.sum())} height(s) are NaN or Inf")
+    heights = heights - heights.mean()
+    # A second pass removes the rounding left by a large offset (heights offset by 1e6 rms).
+    heights -= heights.mean()
+    if not np.any(heights):
+        raise UserError(f"{source}: the surface is flat (all heights equal)")
+    return heights
+
+
+# Options of the surface, with defaults: the embedded default is a surface of
+# group #1 of Table 7.1, (k_l, k_s, H) = (16, 64, 0.8), m2 = 2e-4, N = 256.
+SURFACE_OPTIONS = [
+    ("surface_type", "fractal", "fractal | bisinusoid | wave | sphere (ignored with -surface_file)"),
+    ("surface_file", "", "read heights from PATH (.npy, .h5/.hdf5 dataset 'surface', or a text matrix)"),
+    ("surface_N", 256, "nodes per side (N x N grid)"),
+    ("surface_N0", 0, "rows (axis 0) if different from -surface_N; e.g. a few rows for a 1-D wave"),
+    ("surface_L", 1.0, "cell length along axis 1 (x); axis 0 gets L * N0 / N (square nodes)"),
+    ("surface_kl", 16.0, "fractal: long-wavelength cut-off k_l = k_r [cycles/length]"),
+    ("surface_ks", 64.0, "fractal: short-wavelength cut-off k_s [cycles/length]"),
+    ("surface_H", 0.8, "fractal: Hurst exponent H in (0, 1)"),
+    ("surface_m2", 2e-4, "fractal: prescribed m2^h (mean square slope along x), sets C by (7.1)"),
+    ("surface_seed", 1, "fractal: seed of the white noise (same surface on any number of ranks)"),
+    ("surface_amplitude", 0.01, "bisinusoid: Delta of (3.52); wave: h of 2h sin^2(pi x/lambda) [length]"),
+    ("surface_wavelength", 0.0, "bisinusoid/wave: wavelength along x (0 = the cell length)"),
+    ("surface_radius", 10.0, "sphere: radius R of the paraboloid -r^2/(2R) [length]"),
+]
+
+
+def grid_from_options(opts):
+    """The :class:`Grid` named by ``-surface_N``, ``-surface_N0`` and ``-surface_L``."""
+    n1 = opts.getInt("surface_N", 256)
+    n0 = opts.getInt("surface_N0", 0) or n1
+    length = opts.getReal("surface_L", 1.0)
+    if n1 < 2 or n0 < 1:
+        raise UserError(f"-surface_N must be at least 2 (and -surface_N0 at least 1), got N={n1}, N0={n0}")
+    if not (length > 0 and np.isfinite(length)):
+        raise UserError(f"-surface_L must be a positive length, got {length}")
+    return Grid(n0, n1, length * n0 / n1, length)
+
+
+def from_options(opts, seed=None):
+    """Build the surface named by the options: ``(grid, heights)``, heights of shape ``grid.shape``.
+
+    ``opts`` is a ``petsc4py.PETSc.Options`` (or anything with its ``get*``
+    methods). ``seed`` overrides ``-surface_seed`` (ensembles). The full array
+    is built on every rank, so the surface does not depend on the number of
+    ranks.
+    """
+    path = opts.getString("surface_file", "")
+    if path:
+        heights = load(path)
+        length = opts.getReal("surface_L", 1.0)
+        if not (length > 0 and np.isfinite(length)):
+            raise UserError(f"-surface_L must be a positive length, got {length}")
+        n0, n1 = heights.shape
+        return Grid(n0, n1, length * n0 / n1, length), heights
+    grid = grid_from_options(opts)
+    kind = opts.getString("surface_type", "fractal")
+    if kind == "fractal":
+        seed = opts.getInt("surface_seed", 1) if seed is None else seed
+        heights = fractal(grid, opts.getReal("surface_kl", 16.0), opts.getReal("surface_ks", 64.0),
+                          opts.getReal("surface_H", 0.8), opts.getReal("surface_m2", 2e-4), seed)
+    elif kind in ("bisinusoid", "wave"):
+        amplitude = opts.getReal("surface_amplitude", 0.01)
+        wavelength = opts.getReal("surface_wavelength", 0.0) or grid.l1
+        if not (amplitude > 0 and wavelength > 0):
+            raise UserError("-surface_amplitude and -surface_wavelength must be positive")
+        if kind == "wave":
+            heights = wave(grid, amplitude, wavelength)
+        else:
+            heights = bisinusoid(grid, amplitude, wavelength * grid.l0 / grid.l1, wavelength)
+    elif kind == "sphere":
+        radius = opts.getReal("surface_radius", 10.0)
+        if not radius > 0:
+            raise UserError(f"-surface_radius must be positive, got {radius}")
+        heights = hertz_sphere(grid, radius)
+    else:
+        raise UserError(f"-surface_type: unknown type '{kind}' (fractal, bisinusoid, wave, sphere)")
+    return grid, validate(heights, f"-surface_type {kind}")

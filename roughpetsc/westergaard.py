@@ -1,0 +1,203 @@
+"""The periodic Westergaard operator (3.33) as a matrix-free PETSc shell Mat.
+
+``w = F^-1[ F[p] / (pi E* |k|) ]`` for k != 0; the k = 0 mode carries no
+displacement (the mean pressure only moves the body rigidly, SPEC 1), so the
+mean of ``w`` is zero and the mean gap equals the rigid separation (3.38).
+
+One rank: a direct 2-D FFTW plan (pyFFTW, r2c and c2r, built once with
+``FFTW_MEASURE``) that reads the input Vec's memory and writes the output Vec's
+memory in place: one r2c, one pointwise product, one c2r per application and no
+N^2 copy. Several ranks: mpi4py-fft slabs (rows of the real array distributed
+like PETSc's ownership ranges).
+"""
+
+import numpy as np
+from petsc4py import PETSc
+
+from .errors import UserError
+
+
+def _wavenumber_modulus(grid, rows=slice(None), cols=slice(None)):
+    k0, k1 = grid.rfft_wavenumbers(rows)
+    return np.hypot(k0, k1[:, cols])
+
+
+class _SerialTransform:
+    """2-D real FFT pair on one rank through pyFFTW plans made once."""
+
+    def __init__(self, grid, threads, effort):
+        import pyfftw
+
+        shape = grid.shape
+        self._alignment = pyfftw.simd_alignment
+        self.real = pyfftw.empty_aligned(shape, dtype="float64")
+        self.spectrum = pyfftw.empty_aligned((shape[0], shape[1] // 2 + 1), dtype="complex128")
+        # Aligned plans run twice as fast as FFTW_UNALIGNED ones here; a Vec whose
+        # memory happens to be aligned is used in place, any other goes through
+        # self.real (a copy costs a few percent of a transform).
+        self._forward = pyfftw.FFTW(self.real, self.spectrum, axes=(0, 1), direction="FFTW_FORWARD",
+                                    flags=(effort,), threads=threads)
+        self._backward = pyfftw.FFTW(self.spectrum, self.real, axes=(0, 1), direction="FFTW_BACKWARD",
+                                     flags=(effort, "FFTW_DESTROY_INPUT"), threads=threads)
+        self.local_rows = slice(0, shape[0])
+        self.spectral_slice = (slice(None), slice(None))
+
+    def _aligned(self, array):
+        return array.ctypes.data % self._alignment == 0
+
+    def filter(self, source, target, symbol):
+        """``target = irfft2(symbol * rfft2(source))``, unnormalised (1/N is in the symbol).
+
+        ``symbol`` is real and given per float of the complex spectrum (each
+        value twice), so the product is one contiguous real multiply.
+        """
+        if self._aligned(source):
+            self._forward.update_arrays(source, self.spectrum)
+        else:
+            self.real[...] = source
+            self._forward.update_arrays(self.real, self.spectrum)
+        self._forward.execute()
+        self.spectrum.view(np.float64).__imul__(symbol)
+        direct = self._aligned(target)
+        self._backward.update_arrays(self.spectrum, target if direct else self.real)
+        self._backward.execute()
+        if not direct:
+            target[...] = self.real
+
+
+class _SlabTransform:
+    """2-D real FFT pair over MPI ranks (mpi4py-fft slab decomposition along axis 0)."""
+
+    def __init__(self, grid, comm, effort):
+        from mpi4py_fft import PFFT, newDistArray
+
+        self._fft = PFFT(comm, grid.shape, axes=(0, 1), dtype=float, grid=(-1,),
+                         backend="pyfftw", planner_effort=effort)
+        self.real = newDistArray(self._fft, False)
+        self.spectrum = newDistArray(self._fft, True)
+        self.local_rows = self._fft.local_slice(False)[0]
+        self.spectral_slice = self._fft.local_slice(True)
+
+    def filter(self, source, target, symbol):
+        self.real[...] = source
+        self._fft.forward(self.real, self.spectrum, normalize=False)
+        self.spectrum.view(np.float64).__imul__(symbol)
+        self._fft.backward(self.spectrum, self.real, normalize=False)
+        target[...] = self.real
+
+    def destroy(self):
+        self._fft.destroy()
+
+
+class Westergaard:
+    """Compliance of the periodic half-space, (3.33), applied through FFTW.
+
+    Parameters
+    ----------
+    grid : surfaces.Grid
+        The periodic cell.
+    E_star : float
+        Composite modulus E* (1.6) in pressure units.
+    comm : petsc4py.PETSc.Comm
+        Communicator; on one rank a direct 2-D FFTW plan is used.
+    threads : int
+        FFTW threads of the one-rank plan.
+    effort : str
+        FFTW planner flag (``FFTW_ESTIMATE``, ``FFTW_MEASURE``, ``FFTW_PATIENT``).
+
+    Attributes
+    ----------
+    local_rows : slice
+        Rows of the real-space grid owned by this rank (PETSc ownership).
+    applications : int
+        Number of compliance applications so far (operator applications).
+    """
+
+    def __init__(self, grid, E_star, comm=None, threads=1, effort="FFTW_MEASURE"):
+        comm = comm or PETSc.COMM_WORLD
+        size = comm.getSize()
+        if grid.n0 % size:
+            raise UserError(f"the grid has {grid.n0} rows, which {size} MPI ranks cannot share evenly: "
+                            "choose -surface_N0 (or -surface_N) divisible by the number of ranks")
+        self.grid = grid
+        self.E_star = float(E_star)
+        self.comm = comm
+        if size == 1:
+            self._transform = _SerialTransform(grid, threads, effort)
+        else:
+            self._transform = _SlabTransform(grid, comm.tompi4py(), effort)
+        self.local_rows = self._transform.local_rows
+        self.local_shape = (self.local_rows.stop - self.local_rows.start, grid.n1)
+        k = _wavenumber_modulus(grid, *self._transform.spectral_slice)
+        with np.errstate(divide="ignore"):
+            # The 1/(n0 n1) of the unnormalised FFT pair is folded into the symbols.
+            compliance = np.where(k > 0, 1.0 / (np.pi * self.E_star * k), 0.0) / grid.size
+        stiffness = np.pi * self.E_star * k / grid.size
+        # One value per float of the complex spectrum: see _SerialTransform.filter.
+        self._compliance = np.repeat(compliance, 2, axis=1)
+        self._stiffness = np.repeat(stiffness, 2, axis=1)
+        self.applications = 0
+
+    @property
+    def diagonal(self):
+        """The (constant) diagonal of the compliance matrix: mean of its symbol."""
+        n0, n1 = self.grid.shape
+        k = _wavenumber_modulus(self.grid)
+        with np.errstate(divide="ignore"):
+            symbol = np.where(k > 0, 1.0 / (np.pi * self.E_star * k), 0.0)
+        # rfft layout: the columns 1..n1/2 (exclusive of Nyquist for even n1) stand for two modes.
+        weights = np.full(n1 // 2 + 1, 2.0)
+        weights[0] = 1.0
+        if n1 % 2 == 0:
+            weights[-1] = 1.0
+        return float((symbol * weights).sum() / (n0 * n1))
+
+    def vec(self):
+        """A new distributed Vec laid out like the grid (rows owned by this rank)."""
+        v = PETSc.Vec().create(comm=self.comm)
+        v.setSizes((self.local_shape[0] * self.local_shape[1], self.grid.size))
+        v.setUp()
+        return v
+
+    def local(self, v, readonly=False):
+        """This rank's part of ``v`` as a ``(rows, n1)`` array view."""
+        array = v.getArray(readonly=readonly)
+        return array.reshape(self.local_shape)
+
+    def displacement(self, pressure, out):
+        """``out = K pressure``: surface displacement (3.33), zero mean, length units."""
+        self.applications += 1
+        self._transform.filter(self.local(pressure, readonly=True), self.local(out), self._compliance)
+
+    def pressure_surface(self, heights, out):
+        """``out = F^-1[pi E* |k| F[heights]]``: the complete-contact pressure p_c of (2.47)."""
+        self._transform.filter(self.local(heights, readonly=True), self.local(out), self._stiffness)
+
+    def mat(self):
+        """The compliance as a symmetric shell Mat (``MATPYTHON``); destroy it when done."""
+        n_local = self.local_shape[0] * self.local_shape[1]
+        mat = PETSc.Mat().createPython(((n_local, self.grid.size), (n_local, self.grid.size)),
+                                       context=_ShellContext(self), comm=self.comm)
+        mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        mat.setUp()
+        return mat
+
+    def destroy(self):
+        if hasattr(self._transform, "destroy"):
+            self._transform.destroy()
+
+
+class _ShellContext:
+    """The MATPYTHON context of :meth:`Westergaard.mat`."""
+
+    def __init__(self, operator):
+        self.operator = operator
+
+    def mult(self, mat, x, y):
+        self.operator.displacement(x, y)
+
+    def multTranspose(self, mat, x, y):
+        self.operator.displacement(x, y)
+
+    def getDiagonal(self, mat, d):
+        d.set(self.operator.diagonal)

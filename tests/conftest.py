@@ -1,0 +1,23 @@
+"""Shared test set-up: PETSc initialised once; helpers to run the command line."""
+
+import os
+import subprocess
+import sys
+
+import petsc4py
+
+petsc4py.init([sys.argv[0]])
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OMPI_MCA_rmaps_base_oversubscribe": "1", "OMPI_MCA_btl_vader_single_copy_mechanism": "none"}
+
+
+def run_cli(args, ranks=1, cwd=None, timeout=600):
+    """Run ``python -m roughpetsc args`` on ``ranks`` MPI ranks; returns the CompletedProcess."""
+    command = [sys.executable, "-m", "roughpetsc", *[str(a) for a in args]]
+    if ranks > 1:
+        command = ["mpiexec", "-n", str(ranks), "--oversubscribe", *command]
+    env = dict(os.environ, **MPI_ENV)
+    env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
+    return subprocess.run(command, capture_output=True, text=True, cwd=cwd or ROOT, env=env, timeout=timeout)

@@ -1,0 +1,55 @@
+"""Every bound-constrained TAO type solves the displacement-controlled QP to the same pressure field."""
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from roughpetsc.contact import ContactProblem
+from roughpetsc.control import Solver
+from roughpetsc.surfaces import Grid, fractal
+
+TYPES = ["blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bnls", "bntr", "tron", "gpcg"]
+
+
+@pytest.fixture(scope="module")
+def reference():
+    """Load control by Polonsky-Keer at p* = 0.5 on a 128^2 group-#1 surface, solved to 1e-12."""
+    grid = Grid(128, 128)
+    problem = ContactProblem(grid, fractal(grid, 16, 64, 0.8, 2e-4, 7), 1.0, PETSc.COMM_SELF,
+                             fft_effort="FFTW_ESTIMATE")
+    solver = Solver(problem, "load", None, 1e-12)
+    result = solver.solve(pstar=0.5)
+    pressure = solver.fields()[0].copy()
+    solver.destroy()
+    assert result.converged
+    yield problem, result, pressure
+    problem.destroy()
+
+
+@pytest.mark.parametrize("tao_type", TYPES)
+def test_type_converges_to_the_pk_pressure(reference, tao_type):
+    problem, load_result, pressure = reference
+    solver = Solver(problem, "displacement", tao_type, 1e-8)
+    try:
+        result = solver.solve(gbar=load_result.separation)
+        assert result.converged, result.reason
+        assert result.kkt.natural <= 1e-8
+        field = solver.fields()[0]
+        assert np.abs(field - pressure).max() <= 1e-6 * np.abs(pressure).max()
+        assert result.pstar == pytest.approx(0.5, rel=1e-6)
+    finally:
+        solver.destroy()
+
+
+@pytest.mark.parametrize("tao_type", ["bqnls", "almm"])
+def test_other_load_controls_agree_with_pk(reference, tao_type):
+    problem, load_result, pressure = reference
+    solver = Solver(problem, "load", tao_type, 1e-8)
+    try:
+        result = solver.solve(pstar=0.5)
+        assert result.converged, result.reason
+        assert result.kkt.load_error <= 1e-8
+        assert np.abs(solver.fields()[0] - pressure).max() <= 1e-6 * np.abs(pressure).max()
+        assert result.A == load_result.A
+    finally:
+        solver.destroy()
