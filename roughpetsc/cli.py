@@ -76,25 +76,17 @@ def print_help(tables):
 
 
 def surface_statistics(grid, heights, E_star):
-    """Spectral moments m0h, m2h, m4h (x and y averaged, (2.13)), m0p..m4p of p_c, alpha^h, alpha^p."""
-    spectrum = np.fft.rfft2(heights) / grid.size
-    k0, k1 = grid.rfft_wavenumbers()
-    weight = np.full(k1.shape, 2.0)
-    weight[0, 0] = 1.0
-    if grid.n1 % 2 == 0:
-        weight[0, -1] = 1.0
-    power = weight * np.abs(spectrum) ** 2
-    w0, w1 = 2 * np.pi * k0, 2 * np.pi * k1
-    pressure_power = power * (np.pi * E_star) ** 2 * (k0 ** 2 + k1 ** 2)
+    """Spectral moments of h (n = 0..6) and of p_c (n = 0..4), x/y averaged, and alpha^h, alpha^p (2.16, 2.54)."""
+    from . import spectra
 
-    def moment(spectral_power, n):
-        return 0.5 * float(np.sum(spectral_power * (w1 ** n + w0 ** n)))
-
-    m = {f"m{n}h": moment(power, n) for n in (0, 2, 4, 6)}
-    m.update({f"m{n}p": moment(pressure_power, n) for n in (0, 2, 4)})
-    m["alpha_h"] = m["m0h"] * m["m4h"] / m["m2h"] ** 2
-    m["alpha_p"] = m["m0p"] * m["m4p"] / m["m2p"] ** 2
-    return m
+    mh = spectra.isotropic_mean(spectra.spectral_moments(grid, heights))
+    pressure = spectra.pressure_surface(grid, heights, E_star)
+    mp = spectra.isotropic_mean(spectra.spectral_moments(grid, pressure, (0, 2, 4)))
+    statistics = {f"m{n}h": mh[n] for n in sorted(mh)}
+    statistics.update({f"m{n}p": mp[n] for n in sorted(mp)})
+    statistics["alpha_h"] = spectra.bandwidth(mh[0], mh[2], mh[4])
+    statistics["alpha_p"] = spectra.bandwidth(mp[0], mp[2], mp[4])
+    return statistics
 
 
 def load_steps(reader):

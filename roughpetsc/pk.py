@@ -35,35 +35,33 @@ class PolonskyKeer:
         for v in (self.displacement, self.direction, self.direction_response):
             v.destroy()
 
-    def _contact_mean(self, values, in_contact):
-        total, count = allsum(self.problem.mpi, [values[in_contact].sum(), np.count_nonzero(in_contact)])
-        return total / count if count else 0.0
-
     def solve(self, tao):
         problem = self.problem
         operator = problem.operator
+        mpi = problem.mpi
         n = problem.n
         pbar = self.target_pbar
         pressure = tao.getSolution()
-        p = problem.local(pressure)
-        h = problem.local(problem.heights, readonly=True)
-        u = problem.local(self.displacement)
-        t = problem.local(self.direction)
-        r = problem.local(self.direction_response)
+        p = problem.local(pressure).ravel()
+        h = problem.local(problem.heights, readonly=True).ravel()
+        gap = problem.local(self.displacement).ravel()
+        t = problem.local(self.direction).ravel()
+        r = problem.local(self.direction_response).ravel()
+        contact = np.empty_like(p)  # 1.0 on the contact set, 0.0 elsewhere: masks as dot products
         t[...] = 0.0
         self.history = History(operator)
         max_it = tao.getMaximumIterations()
         norm_old, conjugate = 1.0, False
         iteration, reason = 0, PETSc.TAO.Reason.DIVERGED_MAXITS
         while True:
-            in_contact = p > 0
+            np.greater(p, 0.0, out=contact)
             operator.displacement(pressure, self.displacement)
-            gap = u  # reuse the displacement storage for the gap: g = K p - h + d
             gap -= h
-            mean_gap = self._contact_mean(gap, in_contact)
-            gap -= mean_gap
+            count, gap_sum = allsum(mpi, [contact.sum(), np.dot(gap, contact)])
+            mean_gap = gap_sum / count
+            gap -= mean_gap  # g = K p - h + d with d fixed by a zero mean gap on the contact set
             self.separation = -mean_gap
-            kkt = report(problem.mpi, p, gap, n, pbar)
+            kkt = report(mpi, p, gap, n, pbar)
             self.history.record(iteration, kkt.natural)
             tao.monitor(its=iteration, f=kkt.complementarity, res=kkt.natural, cnorm=kkt.load_error or 0.0)
             if kkt.natural <= self.rtol and kkt.load_error <= self.rtol:
@@ -71,17 +69,18 @@ class PolonskyKeer:
                 break
             if iteration >= max_it:
                 break
-            # Conjugate direction on the contact set.
-            norm, = allsum(problem.mpi, [np.dot(gap[in_contact], gap[in_contact])])
-            beta = norm / norm_old if conjugate else 0.0
-            t *= beta
-            t += gap
-            t[~in_contact] = 0.0
+            # Conjugate direction on the contact set: t = g_c + beta t_c.
+            t *= contact
+            np.multiply(gap, contact, out=r)  # r holds g_c until K t overwrites it
+            norm, = allsum(mpi, [np.dot(r, r)])
+            t *= norm / norm_old if conjugate else 0.0
+            t += r
             norm_old = norm
             operator.displacement(self.direction, self.direction_response)
-            r -= self._contact_mean(r, in_contact)
-            numerator, denominator = allsum(problem.mpi, [np.dot(gap[in_contact], t[in_contact]),
-                                                          np.dot(r[in_contact], t[in_contact])])
+            # Step length with K t less its mean on the contact set (t vanishes off it).
+            r_sum, t_sum, numerator, r_dot_t = allsum(mpi, [np.dot(r, contact), t.sum(), np.dot(gap, t),
+                                                             np.dot(r, t)])
+            denominator = r_dot_t - r_sum / count * t_sum
             if not denominator > 0:
                 reason = PETSc.TAO.Reason.DIVERGED_LS_FAILURE
                 break
@@ -89,11 +88,12 @@ class PolonskyKeer:
             p -= step * t
             np.maximum(p, 0.0, out=p)
             # Nodes out of contact that the gap says overlap re-enter; then restart CG.
-            overlap = (p == 0) & (gap < 0)
-            entering, = allsum(problem.mpi, [np.count_nonzero(overlap)])
-            p[overlap] -= step * gap[overlap]
+            overlap = (gap < 0) & (p == 0)
+            entering, = allsum(mpi, [np.count_nonzero(overlap)])
+            if entering:
+                np.copyto(p, -step * gap, where=overlap)
             conjugate = entering == 0
-            total, = allsum(problem.mpi, [p.sum()])
+            total, = allsum(mpi, [p.sum()])
             p *= pbar * n / total
             iteration += 1
             tao.setIterationNumber(iteration)

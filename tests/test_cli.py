@@ -111,3 +111,31 @@ def test_bad_input_gives_one_clear_message(tmp_path, args, ranks, named):
     assert len(errors) == 1 and named in errors[0], out.stderr
     assert not output.exists() and not (tmp_path / "never.json").exists()
     assert not [p for p in os.listdir(tmp_path) if p.startswith(".tmp-")]
+
+
+def test_headline_usage_bqnls_on_two_ranks(tmp_path):
+    """`mpiexec -n 2 python -m roughpetsc -tao_type bqnls`: load control by the root find around BQNLS."""
+    out = run_cli(SMALL + ["-tao_type", "bqnls", "-json", tmp_path / "b.json"], ranks=2)
+    assert out.returncode == 0, out.stderr
+    step = json.load(open(tmp_path / "b.json"))["steps"][0]
+    assert step["solver"] == "rootfind(bqnls)" and step["converged"]
+    assert step["pstar"] == pytest.approx(0.5, rel=1e-8)
+
+
+def test_displacement_control_from_the_command_line(tmp_path):
+    out = run_cli(SMALL + ["-json", tmp_path / "p.json"])
+    separation = json.load(open(tmp_path / "p.json"))["steps"][0]["separation"]
+    out = run_cli(SMALL + ["-gbar", repr(separation), "-tao_type", "gpcg", "-json", tmp_path / "d.json"])
+    assert out.returncode == 0, out.stderr
+    step = json.load(open(tmp_path / "d.json"))["steps"][0]
+    assert step["control"] == "displacement" and step["converged"]
+    assert step["gbar"] == pytest.approx(separation, rel=1e-6)
+    assert step["pstar"] == pytest.approx(0.5, rel=1e-6)
+
+
+def test_non_convergence_is_reported_with_petsc_reason(tmp_path):
+    out = run_cli(SMALL + ["-tao_max_it", 3, "-json", tmp_path / "n.json"])
+    assert out.returncode == 3
+    assert "NOT CONVERGED" in out.stdout
+    step = json.load(open(tmp_path / "n.json"))["steps"][0]
+    assert not step["converged"] and step["reason"] == "DIVERGED_MAXITS" and step["kkt"]["natural"] > 1e-8

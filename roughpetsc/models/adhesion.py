@@ -163,9 +163,10 @@ class AdhesiveCrack:
             hi = np.where(below, hi, mid)
         return 0.5 * (lo + hi)
 
-    def curve(self, n=2001):
-        """The whole Maugis-Dugdale solution curve: (p*, b*, m), from F to A."""
-        q = np.linspace(0.0, 25.0, n)
+    def curve(self, n=2001, q_max=12.0):
+        """The Maugis-Dugdale solution curve (p*, b*, m) from F (m = 0) towards A,
+        m = 1 - exp(-q) for q in [0, q_max]."""
+        q = np.linspace(0.0, q_max, n)
         return self.p_of_q(q), self.b_of_q(q), self.m_of_q(q)
 
     # equilibrium quantities -----------------------------------------------------

@@ -32,12 +32,13 @@ def fractal_moments(k_l, k_s, H, C):
     return tuple(out)
 
 
-def persson_gap(pstar, k_l, k_s, H, m2, E_star, gamma=1.0, n_elements=64, order=8):
+def persson_gap(pstar, k_l, k_s, H, m2, E_star, gamma=1.0, n_elements=32, order=8):
     """Persson's mean interfacial gap, appendix E, Eq. (E.7) (k from k_l to k_s).
 
     The inner pressure integral is exact, int_p^inf exp(-p'^2/(2 m0p(k))) dp'/p'
     = E1(p^2 / (2 m0p(k))) / 2; the wavenumber integral uses the shared
-    Gauss-Legendre rule in ln k.
+    Gauss-Legendre rule in v with k = k_l exp(v^2), which removes the
+    (k - k_l)^(-1/2) endpoint behaviour of 1/sqrt(m0p(k)).
 
     Parameters
     ----------
@@ -67,10 +68,10 @@ def persson_gap(pstar, k_l, k_s, H, m2, E_star, gamma=1.0, n_elements=64, order=
     C = psd_amplitude(k_l, k_s, H, m2)
     m0h = fractal_moments(k_l, k_s, H, C)[0]
     pbar = p * E_star * np.sqrt(m2 / 2.0)
-    s, w = gauss_legendre(n_elements, order, np.log(k_l), np.log(k_s))
-    k = np.exp(s)
+    v, w = gauss_legendre(n_elements, order, 0.0, np.sqrt(np.log(k_s / k_l)))
+    k = k_l * np.exp(v * v)
     m0p = E_star ** 2 / 8.0 * (2 * np.pi) ** 3 * C / (1.0 - H) * (k ** (2 - 2 * H) - k_l ** (2 - 2 * H))  # (E.4)
     S = C * k ** (-2.0 * (1.0 + H))
     inner = 0.5 * exp1(pbar[:, None] ** 2 / (2.0 * m0p[None, :]))
-    integrand = k ** 2 * S * 2.0 / np.sqrt(2.0 * np.pi * m0p) * inner * k        # dk = k ds
+    integrand = k ** 2 * S * 2.0 / np.sqrt(2.0 * np.pi * m0p) * inner * k * 2.0 * v   # dk = 2 v k dv
     return E_star * np.pi ** 2 * gamma / np.sqrt(m0h) * np.sum(w * integrand, axis=1)
