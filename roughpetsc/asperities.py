@@ -282,6 +282,7 @@ def l1_distance_from_counts(counts, total, edges, pdf):
     expected = bin_probabilities(pdf, edges)
     expected = np.append(expected, max(0.0, 1.0 - expected.sum()))
     distance = float(np.sum(np.abs(measured - expected)))
+    expected = np.clip(expected, 0.0, 1.0)  # rounding can leave -1e-20 in a far tail bin
     noise = float(np.sum(np.sqrt(2.0 * expected * (1.0 - expected) / (np.pi * total))))
     return distance, noise
 

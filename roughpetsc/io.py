@@ -56,8 +56,8 @@ def check_writable(path, option):
         raise UserError(f"-{option}: cannot write into the folder of {path}")
 
 
-class _Atomic:
-    """Context manager giving a temporary path that replaces ``path`` on success only."""
+class atomic_path:
+    """Context manager giving a temporary path (same folder, same suffix) that replaces ``path`` on success only."""
 
     def __init__(self, path):
         self.path = path
@@ -90,7 +90,7 @@ def _jsonable(value):
 
 def write_json(path, data):
     """Write ``data`` as indented JSON, atomically."""
-    with _Atomic(path) as temporary:
+    with atomic_path(path) as temporary:
         with open(temporary, "w") as f:
             json.dump(_jsonable(data), f, indent=2)
             f.write("\n")
@@ -110,7 +110,7 @@ def write_h5(path, summary, fields=None, histories=None):
     """
     import h5py
 
-    with _Atomic(path) as temporary:
+    with atomic_path(path) as temporary:
         with h5py.File(temporary, "w") as f:
             for key, value in summary.items():
                 if key == "steps":

@@ -34,28 +34,25 @@ class KKTReport:
         return asdict(self)
 
 
-def allsum(comm, values):
-    """Global sums of a sequence of local floats in one reduction (mpi4py communicator)."""
+def _allreduce(comm, values, operation):
     local = np.asarray(values, dtype=np.float64)
     if comm.Get_size() == 1:
         return local
     from mpi4py import MPI
 
     total = np.empty_like(local)
-    comm.Allreduce(local, total, op=MPI.SUM)
+    comm.Allreduce(local, total, op=getattr(MPI, operation))
     return total
+
+
+def allsum(comm, values):
+    """Global sums of a sequence of local floats in one reduction (mpi4py communicator)."""
+    return _allreduce(comm, values, "SUM")
 
 
 def allmin(comm, values):
-    """Global minima of a sequence of local floats."""
-    local = np.asarray(values, dtype=np.float64)
-    if comm.Get_size() == 1:
-        return local
-    from mpi4py import MPI
-
-    total = np.empty_like(local)
-    comm.Allreduce(local, total, op=MPI.MIN)
-    return total
+    """Global minima of a sequence of local floats in one reduction."""
+    return _allreduce(comm, values, "MIN")
 
 
 def report(comm, pressure, gap, n_total, target_pbar=None):

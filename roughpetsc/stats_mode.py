@@ -25,6 +25,7 @@ import numpy as np
 
 from . import asperities, spectra
 from .errors import UserError
+from .io import atomic_path, versions
 from .surfaces import SURFACE_OPTIONS, fractal_amplitude, from_options
 
 OPTIONS = [
@@ -255,18 +256,6 @@ def pdf_distances(summary):
 # Output
 # ----------------------------------------------------------------------------
 
-def versions():
-    """Versions of the packages that made the numbers."""
-    import mpi4py
-    import petsc4py
-    import scipy
-
-    from . import __version__
-
-    return {"roughpetsc": __version__, "numpy": np.__version__, "scipy": scipy.__version__,
-            "petsc4py": petsc4py.__version__, "mpi4py": mpi4py.__version__, "python": sys.version.split()[0]}
-
-
 def result_document(summary, settings, surface, closed, distances, seeds, grid):
     """Everything written to JSON: a plain dict of numbers, strings and lists."""
     return {
@@ -294,13 +283,8 @@ def result_document(summary, settings, surface, closed, distances, seeds, grid):
 
 def atomic_write(path, writer):
     """Call ``writer(temporary_path)`` and rename the result to ``path``; no half-written file is left."""
-    temporary = f"{path}.tmp-{os.getpid()}"
-    try:
+    with atomic_path(path) as temporary:
         writer(temporary)
-        os.replace(temporary, path)
-    finally:
-        if os.path.exists(temporary):
-            os.remove(temporary)
 
 
 def write_json(path, document):

@@ -10,6 +10,7 @@ import os
 import numpy as np
 
 from ..errors import UserError
+from ..io import atomic_path
 
 OPTIONS = [
     ("models_alpha_h", 2.0, "bandwidth alpha^h of the surface (2.16), > 1.5"),
@@ -115,16 +116,6 @@ def plot(curves, path):
     plt.close(fig)
 
 
-def _atomic_write(path, writer):
-    tmp = path + ".tmp%d" % os.getpid()
-    try:
-        writer(tmp)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-
-
 def run(options, comm):
     """Entry point of ``python -m roughpetsc -mode models`` (work on rank 0)."""
     o = _read(options)
@@ -142,10 +133,11 @@ def run(options, comm):
         for i in (len(c["pstar"]) // 2, -1):
             print("%-16s %10.4f %10.4e %10.4e" % (name, c["pstar"][i], c["A"][i], c["gstar"][i]))
     if o["models_json"]:
-        def w(tmp):
+        with atomic_path(o["models_json"]) as tmp:
             with open(tmp, "w") as fh:
                 json.dump(curves, fh, indent=1)
-        _atomic_write(o["models_json"], w)
     if o["models_plot"]:
-        _atomic_write(o["models_plot"], lambda tmp: plot(curves, tmp + ".png") or os.replace(tmp + ".png", tmp))
+        # The temporary name ends like the target, so matplotlib picks the same format.
+        with atomic_path(o["models_plot"]) as tmp:
+            plot(curves, tmp)
     return curves
