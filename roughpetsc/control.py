@@ -25,7 +25,6 @@ from .kkt import ConvergenceTest, History, report
 from .pk import PolonskyKeer
 
 BOUND_TYPES = ("blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bqnktl", "bnls", "bntr", "bntl", "tron", "gpcg")
-SECOND_ORDER = ("bqnkls", "bqnktr", "bqnktl", "bnls", "bntr", "bntl", "tron", "gpcg")
 DEFAULT_MAX_IT = 100000
 
 
@@ -62,7 +61,7 @@ class BoundQP:
     default), subset type ``subvec`` and PC ``none`` for TRON and GPCG.
     """
 
-    def __init__(self, problem, tao_type, rtol, prefix=""):
+    def __init__(self, problem, tao_type, rtol):
         self.problem = problem
         self.rtol = rtol
         self.separation = 0.0
@@ -77,24 +76,19 @@ class BoundQP:
         self.upper.set(PETSc.INFINITY)
         self.gradient = problem.vec()
         tao = self.tao = PETSc.TAO().create(comm)
-        tao.setOptionsPrefix(prefix)
         tao.setType(tao_type)
         if tao_type in ("tron", "gpcg"):
-            _set_default_option(prefix + "tao_subset_type", "subvec")
+            # The default mask subset and ILU fail on a shell Hessian.
+            _set_default_option("tao_subset_type", "subvec")
+            tao.getKSP().getPC().setType("none")
         tao.setObjectiveGradient(self._objective_gradient, self.gradient)
         tao.setHessian(self._hessian, self.hessian, self.hessian)
         tao.setVariableBounds((self.lower, self.upper))
         tao.setTolerances(gatol=0.0, grtol=0.0, gttol=0.0)
         tao.setMaximumIterations(DEFAULT_MAX_IT)
         tao.setMaximumFunctionEvaluations(10 * DEFAULT_MAX_IT)
-        if tao_type in SECOND_ORDER:
-            ksp = tao.getKSP()
-            if ksp is not None and tao_type in ("tron", "gpcg"):
-                ksp.getPC().setType("none")
         tao.setFromOptions()
         self.tao_type = tao.getType()
-        self.history = None
-        self.target_pbar = None
 
     def _objective_gradient(self, tao, x, gradient):
         """f = p'Kp/2 + p'(d - h) = (p'g + d sum(p) - p'h) / 2 with the gradient g = K p + d - h."""

@@ -55,6 +55,11 @@ def allmin(comm, values):
     return _allreduce(comm, values, "MIN")
 
 
+def allmax(comm, values):
+    """Global maxima of a sequence of local floats in one reduction."""
+    return _allreduce(comm, values, "MAX")
+
+
 def report(comm, pressure, gap, n_total, target_pbar=None):
     """KKT report of local arrays ``pressure``, ``gap`` (scaled units, rms height 1).
 
@@ -65,10 +70,10 @@ def report(comm, pressure, gap, n_total, target_pbar=None):
     sum_p, sum_pg = allsum(comm, [pressure.sum(), np.dot(pressure, gap)])
     mean_p = sum_p / n_total
     scale = target_pbar if target_pbar else (mean_p if mean_p > 0 else 1.0)
-    natural = allmin(comm, [-np.abs(np.minimum(pressure / scale, gap)).max(initial=0.0)])[0]
+    natural, = allmax(comm, [np.abs(np.minimum(pressure / scale, gap)).max(initial=0.0)])
     min_p, min_g = allmin(comm, [pressure.min(initial=np.inf), gap.min(initial=np.inf)])
     return KKTReport(
-        natural=float(-natural),
+        natural=float(natural),
         complementarity=float(sum_pg / sum_p) if sum_p > 0 else 0.0,
         min_p=float(min_p / scale),
         min_g=float(min_g),

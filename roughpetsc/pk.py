@@ -85,13 +85,16 @@ class PolonskyKeer:
                 reason = PETSc.TAO.Reason.DIVERGED_LS_FAILURE
                 break
             step = numerator / denominator
-            p -= step * t
+            # r (K t) is spent: it is the scratch for the products, so no N^2 temporaries.
+            np.multiply(t, step, out=r)
+            p -= r
             np.maximum(p, 0.0, out=p)
             # Nodes out of contact that the gap says overlap re-enter; then restart CG.
             overlap = (gap < 0) & (p == 0)
             entering, = allsum(mpi, [np.count_nonzero(overlap)])
             if entering:
-                np.copyto(p, -step * gap, where=overlap)
+                np.multiply(gap, -step, out=r)
+                np.copyto(p, r, where=overlap)
             conjugate = entering == 0
             total, = allsum(mpi, [p.sum()])
             p *= pbar * n / total
