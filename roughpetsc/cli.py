@@ -16,10 +16,10 @@ import numpy as np
 
 from .errors import UserError
 
-MODES = ("solve", "stats", "models")
+MODES = ("solve", "stats", "models", "ensemble")
 
 GENERAL_OPTIONS = [
-    ("mode", "solve", "solve | stats | models"),
+    ("mode", "solve", "solve | stats | models | ensemble"),
     ("E_star", 1.0, "composite modulus E* (1.6), pressure units"),
 ]
 
@@ -27,17 +27,22 @@ SOLVE_OPTIONS = [
     ("pstar", 0.5, "load control: p* = pbar / sqrt(m0^p) (the default load)"),
     ("pbar", "", "load control: mean pressure pbar, pressure units"),
     ("gbar", "", "displacement control: prescribed mean gap (rigid separation) d, length units"),
-    ("pstar_list", "", "load control: comma-separated p* values solved in order with warm starts"),
+    ("pstar_list", "", "load control: comma-separated p* values solved in order with warm starts, or 'history' "
+                       "(the 95 steps of (7.11), D1 = 0.2/30)"),
     ("kkt_rtol", 1e-8, "stop when the natural KKT residual ||min(p/pbar, g/sqrt(m0h))||_inf <= this"),
     ("json", "", "write a JSON summary (surface statistics, one entry per load step) to PATH"),
     ("output", "", "write an HDF5 file with heights, pressure and gap fields of the last step to PATH"),
+    ("pk_pc", "fourier", "Polonsky-Keer preconditioner: fourier (inverse symbol pi E*|k| on the contact set) | none"),
+    ("pk_refresh", 50, "Polonsky-Keer: recompute K p from scratch at least every this many iterations"),
     ("fft_threads", 1, "FFTW threads on one rank"),
     ("fft_effort", "FFTW_MEASURE", "FFTW planner effort: FFTW_ESTIMATE | FFTW_MEASURE | FFTW_PATIENT"),
     ("quiet", False, "print nothing but errors"),
 ]
 
 SOLVER_HELP = """Solvers (PETSc options):
-  (no -tao_type)          load control by Polonsky-Keer CG (TAO type python); displacement control by BLMVM
+  (no -tao_type)          Polonsky-Keer projected CG (TAO type python), preconditioned by the inverse Westergaard
+                          symbol (-pk_pc fourier, the default); load control (-pstar/-pbar) or displacement
+                          control (-gbar)
   -tao_type <bound type>  blmvm bqnls bncg bqnkls bqnktr bnls bntr tron gpcg: displacement control directly,
                           load control by a safeguarded root find on the mean gap around that type
   -tao_type almm          load control by TAO ALMM (-tao_almm_subsolver_tao_type bqnls|blmvm|...)
@@ -47,7 +52,8 @@ SOLVER_HELP = """Solvers (PETSc options):
 def _mode_modules():
     """Option tables of the other modes (their modules are imported only if present)."""
     tables = {}
-    for mode, module in (("stats", "roughpetsc.stats_mode"), ("models", "roughpetsc.models.mode")):
+    for mode, module in (("stats", "roughpetsc.stats_mode"), ("models", "roughpetsc.models.mode"),
+                         ("ensemble", "roughpetsc.ensemble")):
         try:
             tables[mode] = __import__(module, fromlist=["OPTIONS"])
         except ImportError:
@@ -95,6 +101,10 @@ def load_steps(reader):
     if len(given) > 1:
         raise UserError("give only one of -pstar, -pbar, -gbar, -pstar_list; got " + ", ".join("-" + g for g in given))
     if given == ["pstar_list"]:
+        if reader.string("pstar_list", "").strip().lower() == "history":
+            from . import loads
+
+            return [("pstar", float(v)) for v in loads.history()], "pstar_list"
         values = reader.reals("pstar_list")
         return [("pstar", v) for v in values], "pstar_list"
     name = given[0] if given else "pstar"
@@ -213,9 +223,9 @@ def main(argv=None):
         if mode in tables:
             from .options import check_unused
 
-            tables[mode].run(reader, comm)
+            status = tables[mode].run(reader, comm)
             check_unused()
-            return 0
+            return status if type(status) is int else 0
         raise UserError(f"-mode: unknown mode '{mode}' (one of {', '.join(['solve'] + list(tables))})")
     except UserError as error:
         if comm.Get_rank() == 0:

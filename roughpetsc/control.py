@@ -3,7 +3,8 @@
 * Displacement control (prescribed mean gap d): ``min 1/2 p'Kp + p'(d - h)``,
   ``p >= 0``, by any TAO bound-constrained type (:class:`BoundQP`).
 * Load control (prescribed pbar):
-  Polonsky-Keer constrained CG as a TAO ``python`` type (:mod:`roughpetsc.pk`),
+  Polonsky-Keer constrained CG as a TAO ``python`` type (:mod:`roughpetsc.pk`,
+  also under displacement control),
   a safeguarded root find on d around :class:`BoundQP` (:class:`RootFind`), or
   TAO ALMM with the equality ``mean(p) = pbar`` (:class:`ALMMLoad`).
 
@@ -275,12 +276,22 @@ class ALMMLoad:
             obj.destroy()
 
 
-class PKLoad:
-    """Load control by Polonsky-Keer, run as a TAO of type ``python`` (so -tao_monitor etc. work)."""
+class PKSolve:
+    """Polonsky-Keer (projected, preconditioned CG) as a TAO of type ``python`` (so -tao_monitor etc. work).
 
-    def __init__(self, problem, rtol):
+    ``solve(target, pressure)`` takes the scaled mean pressure under load
+    control, the scaled separation under displacement control.
+    """
+
+    def __init__(self, problem, rtol, control):
         self.problem = problem
+        self.control = control
         self.context = PolonskyKeer(problem, rtol)
+        try:
+            self.context.configure()
+        except UserError:
+            self.context.destroy()
+            raise
         tao = self.tao = PETSc.TAO().create(problem.comm)
         tao.setType(PETSc.TAO.Type.PYTHON)
         tao.setPythonContext(self.context)
@@ -288,8 +299,13 @@ class PKLoad:
         tao.setFromOptions()
         self.tao_type = "pk"
 
-    def solve(self, pbar, pressure):
-        self.context.target_pbar = pbar
+    def solve(self, target, pressure):
+        if self.control == "load":
+            self.context.target_pbar, self.context.target_separation = target, None
+        else:
+            self.context.target_pbar, self.context.target_separation = None, target
+            local = self.problem.local(pressure)
+            np.maximum(local, 0.0, out=local)
         self.tao.setSolution(pressure)
         self.tao.solve(pressure)
         ctx = self.context
@@ -309,8 +325,8 @@ class Solver:
     problem : ContactProblem
     control : "load" or "displacement"
     tao_type : str or None
-        None: Polonsky-Keer under load control, BLMVM under displacement
-        control; "almm": ALMM (load control only); a bound type: that TAO type
+        None: Polonsky-Keer (preconditioned by default, ``-pk_pc``) under
+        load and displacement control; "almm": ALMM (load control only); a bound type: that TAO type
         (inside the root find under load control).
     rtol : float
         Stopping tolerance on the natural KKT residual (-kkt_rtol).
@@ -328,16 +344,18 @@ class Solver:
         elif tao_type not in BOUND_TYPES:
             raise UserError(f"-tao_type {tao_type} is not a bound-constrained TAO type for this QP; "
                             f"use one of {', '.join(BOUND_TYPES)}, almm, or none (Polonsky-Keer)")
-        if control == "displacement":
-            self.backend = BoundQP(problem, tao_type or "blmvm", rtol)
-        elif tao_type is None:
-            self.backend = PKLoad(problem, rtol)
+        if tao_type is None:
+            self.backend = PKSolve(problem, rtol, control)
+        elif control == "displacement":
+            self.backend = BoundQP(problem, tao_type, rtol)
         elif tao_type == "almm":
             self.backend = ALMMLoad(problem, rtol)
         else:
             self.backend = RootFind(problem, tao_type, rtol)
         self.name = self.backend.tao_type if control == "displacement" or tao_type in (None, "almm") \
             else f"rootfind({self.backend.tao_type})"
+        if tao_type is None:
+            self.name = f"pk({self.backend.context.preconditioner})"
         self.pressure = problem.vec()
         self.pressure.set(0.0)
         self.gap = problem.vec()

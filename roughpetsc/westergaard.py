@@ -110,7 +110,7 @@ class Westergaard:
     local_rows : slice
         Rows of the real-space grid owned by this rank (PETSc ownership).
     applications : int
-        Number of compliance applications so far (operator applications).
+        Number of FFT pairs so far (compliance or stiffness applications).
     """
 
     def __init__(self, grid, E_star, comm=None, threads=1, effort="FFTW_MEASURE"):
@@ -133,9 +133,13 @@ class Westergaard:
             # The 1/(n0 n1) of the unnormalised FFT pair is folded into the symbols.
             compliance = np.where(k > 0, 1.0 / (np.pi * self.E_star * k), 0.0) / grid.size
         stiffness = np.pi * self.E_star * k / grid.size
+        # The preconditioner keeps the mean: its k = 0 mode gets the symbol of the longest wavelength.
+        longest = 1.0 / max(grid.l0, grid.l1)
+        preconditioner = np.pi * self.E_star * np.maximum(k, longest) / grid.size
         # One value per float of the complex spectrum: see _SerialTransform.filter.
         self._compliance = np.repeat(compliance, 2, axis=1)
         self._stiffness = np.repeat(stiffness, 2, axis=1)
+        self._preconditioner = np.repeat(preconditioner, 2, axis=1)
         self.applications = 0
 
     @property
@@ -181,6 +185,17 @@ class Westergaard:
     def pressure_surface(self, heights, out):
         """``out = F^-1[pi E* |k| F[heights]]``: the complete-contact pressure p_c of (2.47)."""
         self._transform.filter(self.local(heights, readonly=True), self.local(out), self._stiffness)
+
+    def stiffness(self, source, target):
+        """``target = F^-1[pi E* max(|k|, 1/L) F[source]]`` on local ``(rows, n1)`` arrays.
+
+        The inverse symbol of the compliance, with the mean (k = 0) mode
+        weighted like the longest wavelength 1/L instead of dropped: the
+        preconditioner of :mod:`roughpetsc.pk`, which needs the mean under
+        displacement control. Counts as an application.
+        """
+        self.applications += 1
+        self._transform.filter(source, target, self._preconditioner)
 
     def mat(self):
         """The compliance as a symmetric shell Mat (``MATPYTHON``); destroy it when done."""

@@ -1,0 +1,68 @@
+"""Polonsky-Keer with and without the Fourier preconditioner, under load and displacement control.
+
+The references are independent algorithms: plain (unpreconditioned) PK and TAO's BLMVM on the
+displacement-controlled QP.
+"""
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from roughpetsc.contact import ContactProblem
+from roughpetsc.control import Solver
+from roughpetsc.surfaces import Grid, fractal
+
+
+@pytest.fixture(scope="module")
+def problem():
+    grid = Grid(128, 128)
+    problem = ContactProblem(grid, fractal(grid, 16, 64, 0.8, 2e-4, 3), 1.0, PETSc.COMM_SELF,
+                             fft_effort="FFTW_ESTIMATE")
+    yield problem
+    problem.destroy()
+
+
+def solve(problem, control, tao_type, preconditioner, rtol, **load):
+    PETSc.Options().setValue("pk_pc", preconditioner)
+    solver = Solver(problem, control, tao_type, rtol)
+    try:
+        result = solver.solve(**load)
+        return result, solver.fields()[0].copy()
+    finally:
+        solver.destroy()
+        PETSc.Options().delValue("pk_pc")
+
+
+# Sparse early contact (small islands) gains least from the Fourier preconditioner.
+@pytest.mark.parametrize("pstar, iteration_ratio", [(0.05, 0.9), (0.5, 0.6), (2.0, 0.6)])
+def test_preconditioned_load_control_matches_plain_pk_in_fewer_iterations(problem, pstar, iteration_ratio):
+    plain, plain_field = solve(problem, "load", None, "none", 1e-10, pstar=pstar)
+    fourier, fourier_field = solve(problem, "load", None, "fourier", 1e-10, pstar=pstar)
+    assert plain.converged and fourier.converged
+    assert fourier.solver == "pk(fourier)" and plain.solver == "pk(none)"
+    assert np.abs(fourier_field - plain_field).max() <= 1e-7 * plain_field.max()
+    assert fourier.A == plain.A
+    assert fourier.gbar == pytest.approx(plain.gbar, rel=1e-8)
+    assert fourier.iterations < iteration_ratio * plain.iterations
+
+
+@pytest.mark.parametrize("preconditioner", ["none", "fourier"])
+def test_displacement_control_matches_blmvm(problem, preconditioner):
+    load, _ = solve(problem, "load", None, "fourier", 1e-10, pstar=0.5)
+    reference, reference_field = solve(problem, "displacement", "blmvm", "none", 1e-9, gbar=load.separation)
+    result, field = solve(problem, "displacement", None, preconditioner, 1e-9, gbar=load.separation)
+    assert reference.converged and result.converged
+    assert result.kkt.load_error is None and result.kkt.natural <= 1e-9
+    assert np.abs(field - reference_field).max() <= 1e-6 * reference_field.max()
+    assert result.pstar == pytest.approx(0.5, rel=1e-7)
+
+
+def test_unknown_preconditioner_is_a_user_error(problem):
+    from roughpetsc.errors import UserError
+
+    PETSc.Options().setValue("pk_pc", "multigrid")
+    try:
+        with pytest.raises(UserError, match="-pk_pc"):
+            Solver(problem, "load", None, 1e-8)
+    finally:
+        PETSc.Options().delValue("pk_pc")
