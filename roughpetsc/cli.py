@@ -34,6 +34,8 @@ SOLVE_OPTIONS = [
     ("output", "", "write an HDF5 file with heights, pressure and gap fields of the last step to PATH"),
     ("pk_pc", "fourier", "Polonsky-Keer preconditioner: fourier (inverse symbol pi E*|k| on the contact set) | none"),
     ("pk_refresh", 50, "Polonsky-Keer: recompute K p from scratch at least every this many iterations"),
+    ("bound_pc", "", "TAO bnls/bntr/bntl/tron/gpcg: fourier (inverse symbol on the free set; default of the BNK "
+                     "types) | none (default of tron, gpcg) | options (-tao_*pc_type decides)"),
     ("fft_threads", 1, "FFTW threads on one rank"),
     ("fft_effort", "FFTW_MEASURE", "FFTW planner effort: FFTW_ESTIMATE | FFTW_MEASURE | FFTW_PATIENT"),
     ("quiet", False, "print nothing but errors"),

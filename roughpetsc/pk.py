@@ -6,15 +6,12 @@ enter the contact set, projection onto p >= 0 and rescaling to the prescribed
 mean pressure after each step. Under displacement control (d prescribed) the
 same projected CG runs with d fixed and without the rescaling.
 
-Preconditioning (``-pk_pc fourier``): the compliance K has the symbol
-1/(pi E* |k|), so its condition number on the contact set grows like N and
-plain PK needs O(N) iterations. The search direction is built from
-``z = P M^-1 r`` instead of the residual ``r``, where ``M^-1`` is the inverse
-symbol pi E* |k| applied in Fourier space to the residual restricted to the
-contact set and ``P`` removes the mean on the contact set (which keeps the
-load). ``P M^-1 P`` is symmetric positive semi-definite on the contact set, so
-this is preconditioned CG on the active set (Vollebregt, J. Comput. Phys. 257,
-2014, without his deflation). It costs one more FFT pair per iteration.
+Preconditioning (``-pk_pc fourier``, the default): plain PK needs O(N)
+iterations because K is ill-conditioned on the contact set; the search
+direction is built from ``z = B r`` instead of the residual ``r``, with ``B``
+the Fourier preconditioner of :mod:`roughpetsc.preconditioner` (preconditioned
+CG on the active set, as Vollebregt, J. Comput. Phys. 257, 2014, without his
+deflation). It costs one more FFT pair per iteration.
 
 Operator applications: the step needs ``K t``; the gap of the new iterate is
 then updated as ``K p <- s (K p - step K t)`` whenever the projection and the
@@ -32,15 +29,10 @@ from petsc4py import PETSc
 
 from .errors import UserError
 from .kkt import History, allsum, report
+from .preconditioner import FourierPreconditioner
 
 PRECONDITIONERS = ("none", "fourier")
 
-# Under displacement control the mean pressure on the contact set is a free mode
-# that the Fourier symbol preconditions badly (its k = 0 mode is the rigid body);
-# it is preconditioned by WEIGHT / <1_C, K 1_C> |C| instead. Measured on group #1
-# at N = 256 and 512 (p* = 0.5): weights 2 to 16 need 50-70 iterations, 1 needs 88,
-# 0.25 needs 248, 64 needs 112.
-MEAN_MODE_WEIGHT = 8.0
 
 
 class PolonskyKeer:
@@ -65,6 +57,7 @@ class PolonskyKeer:
         self.refresh = 50
         self.history = None
         self.vecs = [problem.vec() for _ in range(5)]
+        self.fourier = FourierPreconditioner(problem)
 
     def configure(self):
         """Read ``-pk_pc`` and ``-pk_refresh``.
@@ -89,6 +82,9 @@ class PolonskyKeer:
         for v in self.vecs:
             v.destroy()
         self.vecs = []
+        if self.fourier is not None:
+            self.fourier.destroy()
+            self.fourier = None
 
     def solve(self, tao):
         problem = self.problem
@@ -115,7 +111,6 @@ class PolonskyKeer:
         self.history = History(operator)
         max_it = tao.getMaximumIterations()
         rz_old, conjugate, fresh_needed = 1.0, False, True
-        mean_mode_count, mean_mode_compliance = 0.0, 1.0
         since_fresh = 0
         iteration, reason = 0, PETSc.TAO.Reason.DIVERGED_MAXITS
         while True:
@@ -147,18 +142,8 @@ class PolonskyKeer:
             np.multiply(gap, contact, out=r)
             if precondition:
                 if not load_control:
-                    count, r_sum = allsum(mpi, [contact.sum(), r.sum()])
-                    if abs(count - mean_mode_count) > 0.05 * count:
-                        mean_mode_compliance = self._mean_mode_compliance(contact, count)
-                        mean_mode_count = count
-                operator.stiffness(r.reshape(operator.local_shape), z.reshape(operator.local_shape))
-                z *= contact
-                z_sum, = allsum(mpi, [z.sum()])
-                z -= z_sum / count  # under load control this keeps the load
-                z *= contact
-                if not load_control:
-                    # The mean on the contact set, which the Fourier symbol preconditions badly.
-                    z += r_sum / count / mean_mode_compliance * MEAN_MODE_WEIGHT * contact
+                    count, = allsum(mpi, [contact.sum()])
+                self.fourier.apply(r, z, contact, count, keep_load=load_control)
                 direction = z
             else:
                 direction = r
@@ -202,17 +187,6 @@ class PolonskyKeer:
             tao.setIterationNumber(iteration)
         tao.setIterationNumber(iteration)
         tao.setConvergedReason(reason)
-
-    def _mean_mode_compliance(self, contact, count):
-        """``<1_C, K 1_C> / |C|``: the compliance of a uniform pressure on the contact set C (one application)."""
-        problem = self.problem
-        if len(self.vecs) < 7:
-            self.vecs += [problem.vec(), problem.vec()]
-        indicator, response = self.vecs[5], self.vecs[6]
-        problem.local(indicator).ravel()[...] = contact
-        problem.operator.displacement(indicator, response)
-        energy, = allsum(problem.mpi, [np.dot(problem.local(response, readonly=True).ravel(), contact)])
-        return energy / count
 
     def _interference_start(self, pressure, p, h):
         """Under displacement control, an empty start becomes the best multiple of the interference.
