@@ -30,6 +30,7 @@ SOLVE_OPTIONS = [
     ("pstar_list", "", "load control: comma-separated p* values solved in order with warm starts, or 'history' "
                        "(the 95 steps of (7.11), D1 = 0.2/30)"),
     ("kkt_rtol", 1e-8, "stop when the natural KKT residual ||min(p/pbar, g/sqrt(m0h))||_inf <= this"),
+    ("solve_max_time", 0.0, "stop a solve after this many seconds, reported as DIVERGED_USER (0: no limit)"),
     ("json", "", "write a JSON summary (surface statistics, one entry per load step) to PATH"),
     ("output", "", "write an HDF5 file with heights, pressure and gap fields of the last step to PATH"),
     ("pk_pc", "fourier", "Polonsky-Keer preconditioner: fourier (inverse symbol pi E*|k| on the contact set) | none"),

@@ -55,6 +55,24 @@ def reason_name(reason):
     return str(reason)
 
 
+def max_seconds():
+    """``-solve_max_time``: seconds after which a solve stops with DIVERGED_USER (0: no limit)."""
+    seconds = PETSc.Options().getReal("solve_max_time", 0.0)
+    if not seconds >= 0:
+        raise UserError(f"-solve_max_time must be a non-negative number of seconds, got {seconds}")
+    return seconds
+
+
+def set_from_options(tao, cleanup):
+    """``tao.setFromOptions()``; a bad TAO option becomes a :class:`UserError` naming it, after ``cleanup()``."""
+    try:
+        tao.setFromOptions()
+    except PETSc.Error as error:
+        cleanup()
+        lines = [line.split("]", 1)[-1].strip() for line in str(error).splitlines() if line.strip()]
+        raise UserError(f"a solver option was refused by PETSc: {lines[-1]}") from None
+
+
 def _set_default_option(name, value):
     options = PETSc.Options()
     if not options.hasName(name):
@@ -77,6 +95,7 @@ class BoundQP:
     def __init__(self, problem, tao_type, rtol):
         self.problem = problem
         self.rtol = rtol
+        self.max_seconds = max_seconds()
         self.separation = 0.0
         comm = problem.comm
         self.gap_vec = problem.vec()
@@ -113,7 +132,7 @@ class BoundQP:
         tao.setTolerances(gatol=0.0, grtol=0.0, gttol=0.0)
         tao.setMaximumIterations(DEFAULT_MAX_IT)
         tao.setMaximumFunctionEvaluations(10 * DEFAULT_MAX_IT)
-        tao.setFromOptions()
+        set_from_options(tao, self.destroy)
         self.tao_type = tao.getType()
 
     def _objective_gradient(self, tao, x, gradient):
@@ -140,7 +159,8 @@ class BoundQP:
         self.separation = separation
         self.has_cache = False
         history = history or History(self.problem.operator)
-        test = ConvergenceTest(self.problem.mpi, self.problem.n, self.rtol, self.gap_of, history)
+        test = ConvergenceTest(self.problem.mpi, self.problem.n, self.rtol, self.gap_of, history,
+                               max_seconds=self.max_seconds)
         self.tao.setConvergenceTest(test)
         # A start outside the bounds would be projected by TAO anyway; do it here.
         local = self.problem.local(pressure)
@@ -236,6 +256,7 @@ class ALMMLoad:
     def __init__(self, problem, rtol):
         self.problem = problem
         self.rtol = rtol
+        self.max_seconds = max_seconds()
         self.target = 0.0
         comm = problem.comm
         n_local = problem.operator.local_shape[0] * problem.operator.local_shape[1]
@@ -264,7 +285,7 @@ class ALMMLoad:
         tao.setJacobianEquality(lambda *args: None, self.jacobian, self.jacobian)
         tao.setTolerances(gatol=0.0, grtol=0.0, gttol=0.0)
         tao.setMaximumIterations(DEFAULT_MAX_IT)
-        tao.setFromOptions()
+        set_from_options(tao, self.destroy)
         self.tao_type = "almm"
 
     def _objective_gradient(self, tao, x, gradient):
@@ -289,7 +310,8 @@ class ALMMLoad:
     def solve(self, pbar, pressure):
         self.target = pbar
         history = History(self.problem.operator)
-        test = ConvergenceTest(self.problem.mpi, self.problem.n, self.rtol, self.gap_of, history, target_pbar=pbar)
+        test = ConvergenceTest(self.problem.mpi, self.problem.n, self.rtol, self.gap_of, history, target_pbar=pbar,
+                               max_seconds=self.max_seconds)
         self.tao.setConvergenceTest(test)
         self.tao.setSolution(pressure)
         self.tao.solve(pressure)
@@ -314,6 +336,7 @@ class PKSolve:
         self.problem = problem
         self.control = control
         self.context = PolonskyKeer(problem, rtol)
+        self.context.max_seconds = max_seconds()
         try:
             self.context.configure()
         except UserError:
@@ -323,7 +346,7 @@ class PKSolve:
         tao.setType(PETSc.TAO.Type.PYTHON)
         tao.setPythonContext(self.context)
         tao.setMaximumIterations(DEFAULT_MAX_IT)
-        tao.setFromOptions()
+        set_from_options(tao, self.destroy)
         self.tao_type = "pk"
 
     def solve(self, target, pressure):

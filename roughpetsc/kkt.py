@@ -92,6 +92,10 @@ class History:
     def record(self, iteration, natural):
         self.rows.append((iteration, natural, self.operator.applications, time.perf_counter() - self.start))
 
+    def out_of_time(self, max_seconds):
+        """True when ``max_seconds`` (> 0) have passed since the history started (``-solve_max_time``)."""
+        return max_seconds > 0 and time.perf_counter() - self.start > max_seconds
+
     def as_array(self):
         return np.array(self.rows, dtype=np.float64).reshape(-1, 4)
 
@@ -111,7 +115,7 @@ class ConvergenceTest:
     the objective when possible), ``pbar_of(x)`` the normalising pressure.
     """
 
-    def __init__(self, comm, n_total, rtol, gap_of, history, target_pbar=None, pressure_of=None):
+    def __init__(self, comm, n_total, rtol, gap_of, history, target_pbar=None, pressure_of=None, max_seconds=0.0):
         self.comm = comm
         self.n_total = n_total
         self.rtol = rtol
@@ -119,6 +123,7 @@ class ConvergenceTest:
         self.history = history
         self.target_pbar = target_pbar
         self.pressure_of = pressure_of or (lambda x: x.getArray(readonly=True))
+        self.max_seconds = max_seconds
         self.last = None
 
     def __call__(self, tao):
@@ -130,6 +135,8 @@ class ConvergenceTest:
         load_ok = kkt.load_error is None or kkt.load_error <= self.rtol
         if kkt.natural <= self.rtol and load_ok:
             return PETSc.TAO.Reason.CONVERGED_USER
+        if self.history.out_of_time(self.max_seconds):
+            return PETSc.TAO.Reason.DIVERGED_USER
         if tao.getConvergedReason() > 0 and iteration < tao.getMaximumIterations():
             return PETSc.TAO.Reason.CONTINUE_ITERATING
         return None

@@ -55,6 +55,7 @@ class PolonskyKeer:
         self.separation = 0.0
         self.preconditioner = "fourier"
         self.refresh = 50
+        self.max_seconds = 0.0
         self.history = None
         self.vecs = [problem.vec() for _ in range(5)]
         self.fourier = FourierPreconditioner(problem)
@@ -136,6 +137,9 @@ class PolonskyKeer:
                 reason = PETSc.TAO.Reason.CONVERGED_USER
                 break
             if iteration >= max_it:
+                break
+            if self.history.out_of_time(self.max_seconds):
+                reason = PETSc.TAO.Reason.DIVERGED_USER
                 break
             # Residual on the contact set, preconditioned and restricted to it again.
             r = response

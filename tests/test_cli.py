@@ -98,6 +98,10 @@ BAD_INPUTS = [
     (lambda t: ["-surface_file", t / "missing.npy"], 1, "missing.npy"),
     (lambda t: ["-surface_ks", 200, "-surface_N", 64], 1, "-surface_ks"),
     (lambda t: ["-pbar", "abc"], 1, "-pbar"),
+    (lambda t: ["-tao_type", "bncg", "-tao_bncg_type", "prp_plus"], 1, "-tao_bncg_type"),
+    (lambda t: ["-pk_pc", "jacobi"], 1, "-pk_pc"),
+    (lambda t: ["-tao_type", "bnls", "-bound_pc", "ilu"], 1, "-bound_pc"),
+    (lambda t: ["-solve_max_time", -1], 1, "-solve_max_time"),
 ]
 
 
@@ -139,3 +143,10 @@ def test_non_convergence_is_reported_with_petsc_reason(tmp_path):
     assert "NOT CONVERGED" in out.stdout
     step = json.load(open(tmp_path / "n.json"))["steps"][0]
     assert not step["converged"] and step["reason"] == "DIVERGED_MAXITS" and step["kkt"]["natural"] > 1e-8
+
+
+def test_time_limit_is_reported_as_not_converged(tmp_path):
+    out = run_cli(SMALL + ["-pk_pc", "none", "-solve_max_time", 1e-9, "-json", tmp_path / "t.json"])
+    assert out.returncode == 3
+    step = json.load(open(tmp_path / "t.json"))["steps"][0]
+    assert not step["converged"] and step["reason"] == "DIVERGED_USER"
