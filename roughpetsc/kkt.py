@@ -140,3 +140,51 @@ class ConvergenceTest:
         if tao.getConvergedReason() > 0 and iteration < tao.getMaximumIterations():
             return PETSc.TAO.Reason.CONTINUE_ITERATING
         return None
+
+
+class CompositeCriterion:
+    """The seed's composite convergence criterion, evaluated per iteration as a TAO monitor.
+
+    (3.47) ||p^k - p^(k-1)||_2 / ||p^k||_2 < 5e-5;
+    (3.48) |A^k - A^(k-1)| / A^k < 2 / (Nx Ny);
+    (3.51) sigma_h < min(1e-4 sqrt(m0^h), 0.01 gbar), sigma_h the rms gap over the contact
+           nodes as in (3.50) (the mean over them; the seed's 1/N is read as 1/|contact set|).
+    (3.49), monotone A* and gbar along a load path, involves two solves and is
+    checked by the callers that have a path (ensembles).
+
+    ``gap_of(x)`` returns the gap (scaled, local array) of the iterate ``x``.
+    ``rows`` holds (iteration, (3.47) value, (3.48) value, sigma_h, its bound,
+    natural residual or nan); ``first`` is the first iteration where (3.47),
+    (3.48) and (3.51) all hold.
+    """
+
+    def __init__(self, comm, n_total, gap_of, natural_of=None):
+        self.comm = comm
+        self.n_total = n_total
+        self.gap_of = gap_of
+        self.natural_of = natural_of
+        self.previous = None
+        self.previous_area = None
+        self.rows = []
+        self.first = None
+
+    def __call__(self, tao):
+        x = tao.getSolution()
+        p = x.getArray(readonly=True)
+        g = self.gap_of(x)
+        contact = p > 0
+        p_norm2, change2, n_contact, gap_sum, gap2_contact = allsum(self.comm, [
+            np.dot(p, p), np.dot(p - self.previous, p - self.previous) if self.previous is not None else np.inf,
+            np.count_nonzero(contact), g[~contact].sum(), np.dot(g[contact], g[contact])])
+        area = n_contact / self.n_total
+        relative_change = float(np.sqrt(change2 / p_norm2)) if p_norm2 > 0 else np.inf
+        area_change = abs(area - self.previous_area) / area if self.previous_area is not None and area else np.inf
+        sigma = float(np.sqrt(gap2_contact / n_contact)) if n_contact else 0.0
+        bound = min(1e-4, 0.01 * gap_sum / self.n_total)
+        iteration = tao.getIterationNumber()
+        natural = self.natural_of(x, g) if self.natural_of else float("nan")
+        self.rows.append((iteration, relative_change, area_change, sigma, bound, natural))
+        if self.first is None and relative_change < 5e-5 and area_change < 2.0 / self.n_total and sigma < bound:
+            self.first = iteration
+        self.previous = np.array(p)
+        self.previous_area = area
