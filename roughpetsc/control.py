@@ -408,8 +408,10 @@ class Solver:
             self.name = f"pk({self.backend.context.preconditioner})"
         self.pressure = problem.vec()
         self.pressure.set(0.0)
+        self.previous = problem.vec()  # the solution before the last, for the load-path predictor
         self.gap = problem.vec()
         self.last_separation = None
+        self.solved_targets = []  # scaled loads of the solutions in (previous, pressure)
 
     def solve(self, pbar=None, pstar=None, gbar=None):
         """Solve one load; the previous solution is the start. Returns a :class:`Result`."""
@@ -434,10 +436,30 @@ class Solver:
                 else:
                     outcome = self.backend.solve(target, self.pressure)
         self.last_separation = outcome.separation
+        self.solved_targets = (self.solved_targets + [target])[-2:] if target is not None else []
         return self._result(outcome, target, start, applications)
 
     def _load_start(self, target):
-        """Scale the warm start to the new load (or start from a uniform pressure)."""
+        """The start of a load-controlled solve from the previous solutions.
+
+        After two load-controlled solves, the pressure is extrapolated
+        linearly in the load from them (the predictor of a continuation along
+        the load path, its step ratio capped at 2), projected onto p >= 0; it
+        is then scaled to the new mean pressure. After one, that solution is
+        scaled; with none, the start is uniform.
+        """
+        if len(self.solved_targets) == 2:
+            older, newer = self.solved_targets
+            if newer != older:
+                ratio = min((target - newer) / (newer - older), 2.0)
+                # previous <- (1 + ratio) p_newer - ratio p_older, then swap: the start in pressure,
+                # the newer solution kept in previous for the next step.
+                self.previous.axpby(1.0 + ratio, -ratio, self.pressure)
+                self.pressure, self.previous = self.previous, self.pressure
+                local = self.problem.local(self.pressure)
+                np.maximum(local, 0.0, out=local)
+        else:
+            self.pressure.copy(self.previous)
         mean_p = self.pressure.sum() / self.problem.n
         if mean_p > 0:
             self.pressure.scale(target / mean_p)
@@ -478,4 +500,5 @@ class Solver:
     def destroy(self):
         self.backend.destroy()
         self.pressure.destroy()
+        self.previous.destroy()
         self.gap.destroy()

@@ -110,6 +110,7 @@ class PolonskyKeer:
             self.separation = self.target_separation
             self._interference_start(pressure, p, h)
         self.history = History(operator)
+        self.restarts = 0  # CG restarts: iterations where nodes entered the contact set
         max_it = tao.getMaximumIterations()
         rz_old, conjugate, fresh_needed = 1.0, False, True
         since_fresh = 0
@@ -180,6 +181,7 @@ class PolonskyKeer:
                 np.multiply(gap, -step, out=response)
                 np.copyto(p, response, where=overlap)
             conjugate = entering == 0
+            self.restarts += not conjugate
             if load_control:
                 total, = allsum(mpi, [p.sum()])
                 scale = pbar * n / total
