@@ -108,8 +108,10 @@ def main():
     parser.add_argument("--presets", nargs="*", default=None)
     parser.add_argument("--rtol", type=float, default=1e-10)
     parser.add_argument("--max-time", type=float, default=60.0)
-    parser.add_argument("--big-presets", nargs="*", default=["pk", "pk_plain", "blmvm", "tron", "bnls"],
-                        help="presets run at N >= 2048 (the others take too long there)")
+    parser.add_argument("--large-presets", nargs="*", default=["pk", "pk_plain", "blmvm", "bncg", "tron", "bnls"],
+                        help="presets run at N >= 512 (the others stall or take too long there)")
+    parser.add_argument("--huge-presets", nargs="*", default=["pk", "pk_plain", "tron"],
+                        help="presets run at N >= 2048")
     args = parser.parse_args()
     common.init()
     os.makedirs(OUT, exist_ok=True)
@@ -124,7 +126,7 @@ def main():
                 continue
             runs = []
             for name, options in presets.items():
-                if n >= 2048 and name not in args.big_presets:
+                if (n >= 2048 and name not in args.huge_presets) or (n >= 512 and name not in args.large_presets):
                     continue
                 options = dict(options, solve_max_time=str(args.max_time))
                 if common.load_controls(options):
