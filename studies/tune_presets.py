@@ -19,7 +19,7 @@ CANDIDATES = {
            {"pk_pc": "fourier", "pk_refresh": "200"}],
     "blmvm": [{"tao_blmvm_mat_lmvm_hist_size": v} for v in ("3", "5", "10", "20")],
     "bqnls": [{"tao_bqnls_mat_lmvm_hist_size": v} for v in ("5", "10", "20")],
-    "bncg": [{"tao_bncg_type": v} for v in ("gd", "pcgd", "hs", "fr", "prp", "prp_plus", "dy", "hz", "dk", "kd",
+    "bncg": [{"tao_bncg_type": v} for v in ("gd", "pcgd", "hs", "fr", "prp", "pr", "dy", "hz", "dk", "kd",
                                             "ssml_bfgs", "ssml_dfp", "ssml_brdn")],
     "bqnkls": [{"tao_bqnk_mat_lmvm_hist_size": v} for v in ("5", "10")],
     "bqnktr": [{"tao_bqnk_mat_lmvm_hist_size": v} for v in ("5", "10")],

@@ -1,0 +1,73 @@
+"""Cost of the 95-step load history (7.11) with warm starts against one cold solve at p* = 0.5.
+
+    .venv/bin/python studies/load_history.py [--n 1024] [--presets pk] [--repeat 2]
+
+Group #1 surface (seed 1), natural KKT residual 1e-8 at every step, one process. The history is
+solved in order by one Solver (each step starts from the previous solution scaled to the new load);
+the cold solve starts from a uniform pressure. Target (issue 5): history <= 10x the cold solve.
+Cold and history are alternated ``--repeat`` times and the medians compared (shared machine).
+"""
+
+import argparse
+import os
+import statistics
+import time
+
+import common
+
+
+def history_run(problem, options, loads):
+    from roughpetsc.control import Solver
+
+    with common.options_set(options):
+        solver = Solver(problem, "load", options.get("tao_type") or None, 1e-8)
+    try:
+        start = time.perf_counter()
+        results = [solver.solve(pstar=p) for p in loads]
+        return time.perf_counter() - start, results
+    finally:
+        solver.destroy()
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--n", type=int, default=1024)
+    parser.add_argument("--presets", nargs="*", default=["pk"])
+    parser.add_argument("--repeat", type=int, default=2)
+    args = parser.parse_args()
+    common.init()
+    from roughpetsc.loads import history
+
+    loads = history()
+    problem = common.group1_problem(args.n)
+    lines = []
+    for name, options in common.presets(args.presets).items():
+        cold_times, history_times = [], []
+        for _ in range(args.repeat):
+            seconds, cold = history_run(problem, options, [0.5])
+            cold_times.append(seconds)
+            seconds, results = history_run(problem, options, loads)
+            history_times.append(seconds)
+        converged = sum(r.converged for r in results)
+        its = sum(r.iterations for r in results)
+        pairs = sum(r.operator_applications for r in results)
+        cold_time, history_time = statistics.median(cold_times), statistics.median(history_times)
+        lines.append([name, args.n, f"{cold_time:.2f}", cold[0].iterations, cold[0].operator_applications,
+                      f"{history_time:.2f}", f"{converged}/{len(loads)}", its, pairs,
+                      f"{history_time / cold_time:.2f}", f"{pairs / cold[0].operator_applications:.2f}"])
+        print(" | ".join(map(str, lines[-1])), flush=True)
+    problem.destroy()
+    table = common.markdown_table(["preset", "N", "cold solve s (p*=0.5)", "its", "FFT pairs", "history s",
+                                   "steps converged", "its (sum)", "FFT pairs (sum)", "time ratio",
+                                   "FFT-pair ratio"], lines)
+    text = (f"# The 95-step load history (7.11) against one cold solve\n\nGroup #1, seed 1, natural KKT 1e-8 at "
+            f"every step, one process, medians of {args.repeat} alternated runs. Target: ratio <= 10.\n\n{table}\n\n"
+            f"Regenerate: `.venv/bin/python studies/load_history.py --n {args.n} --presets "
+            f"{' '.join(args.presets)}`\n")
+    with open(os.path.join(common.OUTPUT, f"load_history_N{args.n}.md"), "w") as f:
+        f.write(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
