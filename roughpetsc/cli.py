@@ -182,14 +182,14 @@ def run_solve(reader, comm, say):
                    "surface": statistics, "sqrt_m0h": problem.sqrt_m0h, "sqrt_m0p": problem.sqrt_m0p,
                    "solver": solver.name, "control": control, "kkt_rtol": rtol, "ranks": comm.Get_size(),
                    "steps": [r.summary() for r in results], **io.provenance()}
-        pressure, gap = solver.fields()
-        pressure, gap = _gather_rows(comm, pressure), _gather_rows(comm, gap)
-        if comm.Get_rank() == 0:
-            if json_path:
-                io.write_json(json_path, summary)
-            if h5_path:
+        if h5_path:  # the fields are gathered only for the file (rank 0's memory)
+            pressure, gap = solver.fields()
+            pressure, gap = _gather_rows(comm, pressure), _gather_rows(comm, gap)
+            if comm.Get_rank() == 0:
                 io.write_h5(h5_path, summary, {"heights": heights, "pressure": pressure, "gap": gap},
                             {i: r.history for i, r in enumerate(results)})
+        if json_path and comm.Get_rank() == 0:
+            io.write_json(json_path, summary)
         return 0 if all(r.converged for r in results) else 3
     finally:
         solver.destroy()

@@ -55,6 +55,12 @@ def reason_name(reason):
     return str(reason)
 
 
+def _reason(tao, test):
+    """PETSc's reason, with what our convergence test stopped for (time limit, stagnation)."""
+    name = reason_name(tao.getConvergedReason())
+    return f"{name} ({test.stopped_by})" if test.stopped_by and name == "DIVERGED_USER" else name
+
+
 def max_seconds():
     """``-solve_max_time``: seconds after which a solve stops with DIVERGED_USER (0: no limit)."""
     seconds = PETSc.Options().getReal("solve_max_time", 0.0)
@@ -167,8 +173,7 @@ class BoundQP:
         np.maximum(local, 0.0, out=local)
         self.tao.setSolution(pressure)
         self.tao.solve(pressure)
-        return Outcome(separation, self.tao.getIterationNumber(), reason_name(self.tao.getConvergedReason()),
-                       history.as_array())
+        return Outcome(separation, self.tao.getIterationNumber(), _reason(self.tao, test), history.as_array())
 
     def destroy(self):
         self.tao.destroy()
@@ -201,6 +206,7 @@ class RootFind:
         problem = self.problem
         history = History(problem.operator)
         state = {"iterations": 0, "evaluations": 0, "reason": "DIVERGED_MAXFCN"}
+        time_limit = self.qp.max_seconds
 
         class Found(Exception):
             pass
@@ -219,6 +225,9 @@ class RootFind:
                 state["separation"] = d
                 raise Found
             if state["evaluations"] >= self.max_evaluations:
+                raise Found
+            if history.out_of_time(time_limit):
+                state["reason"] = "DIVERGED_USER (time limit)"
                 raise Found
             return mean_p - pbar
 
@@ -316,8 +325,7 @@ class ALMMLoad:
         self.tao.setSolution(pressure)
         self.tao.solve(pressure)
         self.gap_of(pressure)
-        return Outcome(self.separation, self.tao.getIterationNumber(), reason_name(self.tao.getConvergedReason()),
-                       history.as_array())
+        return Outcome(self.separation, self.tao.getIterationNumber(), _reason(self.tao, test), history.as_array())
 
     def destroy(self):
         self.tao.destroy()

@@ -100,6 +100,11 @@ class History:
         return np.array(self.rows, dtype=np.float64).reshape(-1, 4)
 
 
+# A TAO solve whose natural residual has not improved on its best for this many
+# iterations is stopped (BQNLS can freeze at a fixed iterate without a verdict of its own).
+STAGNATION_ITERATIONS = 500
+
+
 class ConvergenceTest:
     """TAO convergence test on the natural KKT residual (``tao.setConvergenceTest``).
 
@@ -109,7 +114,9 @@ class ConvergenceTest:
     natural residual of the current iterate is at most ``rtol``; a default
     "converged" verdict reached with a larger residual is turned back into
     "continue" while iterations remain, so TAO's own residual measure (which
-    differs by type) never ends a solve early.
+    differs by type) never ends a solve early. It stops a solve with
+    DIVERGED_USER after ``max_seconds`` (if > 0) or when the residual has not
+    improved for ``STAGNATION_ITERATIONS`` iterations (``stopped_by`` says which).
 
     ``gap_of(x)`` returns the local gap array of the iterate ``x`` (cached by
     the objective when possible), ``pbar_of(x)`` the normalising pressure.
@@ -125,6 +132,9 @@ class ConvergenceTest:
         self.pressure_of = pressure_of or (lambda x: x.getArray(readonly=True))
         self.max_seconds = max_seconds
         self.last = None
+        self.best = np.inf
+        self.since_best = 0
+        self.stopped_by = None  # "time limit" or "stagnation" when this test ended the solve
 
     def __call__(self, tao):
         x = tao.getSolution()
@@ -136,6 +146,14 @@ class ConvergenceTest:
         if kkt.natural <= self.rtol and load_ok:
             return PETSc.TAO.Reason.CONVERGED_USER
         if self.history.out_of_time(self.max_seconds):
+            self.stopped_by = "time limit"
+            return PETSc.TAO.Reason.DIVERGED_USER
+        if kkt.natural < self.best:
+            self.best, self.since_best = kkt.natural, 0
+        else:
+            self.since_best += 1
+        if self.since_best >= STAGNATION_ITERATIONS:
+            self.stopped_by = "stagnation"
             return PETSc.TAO.Reason.DIVERGED_USER
         if tao.getConvergedReason() > 0 and iteration < tao.getMaximumIterations():
             return PETSc.TAO.Reason.CONTINUE_ITERATING

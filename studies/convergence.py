@@ -110,6 +110,8 @@ def main():
     parser.add_argument("--max-time", type=float, default=60.0)
     parser.add_argument("--large-presets", nargs="*", default=["pk", "pk_plain", "blmvm", "bncg", "tron", "bnls"],
                         help="presets run at N >= 512 (the others stall or take too long there)")
+    parser.add_argument("--composite-max-n", type=int, default=1024,
+                        help="evaluate the composite criterion (an extra FFT per iteration) up to this N")
     parser.add_argument("--huge-presets", nargs="*", default=["pk", "pk_plain", "tron"],
                         help="presets run at N >= 2048")
     args = parser.parse_args()
@@ -145,18 +147,19 @@ def main():
                       f"{result.time_s:.2f} s, natural {result.kkt.natural:.1e}, {result.reason}", flush=True)
             figures.append(plot(runs, n, pstar))
             records += runs
+            write_report(args, records, figures, composite_rows)  # after every block: partial runs leave a report
             for name in ("pk", "pk_plain"):
-                if name in presets:
+                if name in presets and n <= args.composite_max_n:
                     first, natural = composite_run(problem, presets[name], pstar)
                     composite_rows.append([n, pstar, name, first if first is not None else "never",
                                            f"{natural:.1e}" if natural is not None else "-"])
         problem.destroy()
-    with open(os.path.join(OUT, "convergence.json"), "w") as f:
-        json.dump(records, f)
     write_report(args, records, figures, composite_rows)
 
 
 def write_report(args, records, figures, composite_rows):
+    with open(os.path.join(OUT, "convergence.json"), "w") as f:
+        json.dump(records, f)
     rows = []
     for r in records:
         hit = r["to_1e-8"]
