@@ -7,8 +7,11 @@ mean of ``w`` is zero and the mean gap equals the rigid separation (3.38).
 One rank: a direct 2-D FFTW plan (pyFFTW, r2c and c2r, built once with
 ``FFTW_MEASURE``) that reads the input Vec's memory and writes the output Vec's
 memory in place: one r2c, one pointwise product, one c2r per application and no
-N^2 copy. Several ranks: mpi4py-fft slabs (rows of the real array distributed
-like PETSc's ownership ranges).
+N^2 copy. Several ranks: the slab transform of :mod:`roughpetsc.slab` (rows of
+the real array distributed like PETSc's ownership ranges; on one node the half
+spectrum lives in an MPI-3 shared window, so there is no transpose copy). It
+replaced mpi4py-fft's PFFT (``_SlabTransform``, kept for comparison), which
+was 3.5x slower on 2 ranks here (studies/output/mpi_speedup.md).
 """
 
 import numpy as np
@@ -125,7 +128,9 @@ class Westergaard:
         if size == 1:
             self._transform = _SerialTransform(grid, threads, effort)
         else:
-            self._transform = _SlabTransform(grid, comm.tompi4py(), effort)
+            from .slab import SlabTransform
+
+            self._transform = SlabTransform(grid, comm.tompi4py(), effort)
         self.local_rows = self._transform.local_rows
         self.local_shape = (self.local_rows.stop - self.local_rows.start, grid.n1)
         k = _wavenumber_modulus(grid, *self._transform.spectral_slice)

@@ -1,0 +1,113 @@
+"""The hand-written slab FFT pair (roughpetsc.slab) against numpy's rfft2/irfft2 on 1, 2 and 4 ranks."""
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from roughpetsc.slab import SlabTransform, column_split
+from roughpetsc.surfaces import Grid
+
+from conftest import MPI_ENV, ROOT
+
+# Run under mpiexec: every rank checks its part against numpy on the whole array.
+DRIVER = r"""
+import sys
+import numpy as np
+import pyfftw
+from mpi4py import MPI
+from roughpetsc.slab import SlabTransform
+from roughpetsc.surfaces import Grid
+
+world = MPI.COMM_WORLD
+# On 4 ranks also two groups of 2 (as an ensemble splits the ranks): each group transforms on its own.
+comms = [world] + ([world.Split(world.Get_rank() // 2, world.Get_rank())] if world.Get_size() == 4 else [])
+worst = 0.0
+for comm, exchange in [(c, e) for c in comms for e in ("shared", "alltoall")]:
+    for shape, lengths in (((8, 8), (1.0, 1.0)), ((16, 10), (1.0, 2.0)), ((12, 9), (1.0, 1.0)),
+                           ((64, 96), (0.75, 1.0)), ((256, 256), (1.0, 1.0)), ((32, 6), (1.0, 1.0))):
+        if shape[0] % comm.Get_size():
+            continue
+        grid = Grid(*shape, *lengths)
+        transform = SlabTransform(grid, comm, "FFTW_ESTIMATE", exchange)
+        rows, spectral = transform.local_rows, transform.spectral_slice
+        x = np.random.default_rng(7).standard_normal(shape) + 3.0
+        X = np.fft.rfft2(x)
+        # The symbol as roughpetsc.westergaard builds it from spectral_slice.
+        k0, k1 = grid.rfft_wavenumbers(spectral[0])
+        k = np.hypot(k0, k1[:, spectral[1]])
+        with np.errstate(divide="ignore"):
+            symbol = np.where(k > 0, 1.0 / (np.pi * k), 0.0)
+        full_k = np.hypot(*grid.rfft_wavenumbers())
+        with np.errstate(divide="ignore"):
+            full_symbol = np.where(full_k > 0, 1.0 / (np.pi * full_k), 0.0)
+        expected = np.fft.irfft2(X * full_symbol, s=shape)
+        scale_x, scale_X, scale_e = abs(x).max(), abs(X).max(), abs(expected).max()
+        # Sources and targets: aligned and contiguous, misaligned, and strided views.
+        padded = pyfftw.empty_aligned(x[rows].size + 1)
+        misaligned = padded[1:].reshape(x[rows].shape)
+        wide = np.zeros((x[rows].shape[0], shape[1] * 2))
+        for source_kind in range(3):
+            local = pyfftw.empty_aligned(x[rows].shape)
+            local[...] = x[rows]
+            source = (local, misaligned, wide[:, ::2])[source_kind]
+            source[...] = x[rows]
+            spectrum = transform.forward(source)
+            worst = max(worst, abs(spectrum - X[spectral]).max() / scale_X)
+            assert np.array_equal(source, x[rows])                  # the source is kept
+            spectrum *= 1.0 / grid.size
+            target = (pyfftw.empty_aligned(x[rows].shape), misaligned, wide[:, 1::2])[(source_kind + 1) % 3]
+            transform.backward(target)
+            worst = max(worst, abs(target - x[rows]).max() / scale_x)
+            source[...] = x[rows]
+            transform.filter(source, target, np.repeat(symbol / grid.size, 2, axis=1))
+            worst = max(worst, abs(target - expected[rows]).max() / scale_e)
+        transform.destroy()
+automatic = SlabTransform(Grid(8, 8), world, "FFTW_ESTIMATE")
+assert automatic.exchange == "shared"                        # mpiexec on one machine: one node
+automatic.destroy()
+worst = world.allreduce(worst, op=MPI.MAX)
+if world.Get_rank() == 0:
+    print(f"worst {worst:.3e}")
+sys.exit(0 if worst <= 1e-12 else 1)
+"""
+
+
+def run_driver(ranks, tmp_path):
+    driver = tmp_path / "slab_driver.py"
+    driver.write_text(DRIVER)
+    env = dict(os.environ, **MPI_ENV)
+    env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
+    command = ["mpiexec", "-n", str(ranks), "--oversubscribe", sys.executable, str(driver)]
+    return subprocess.run(command, capture_output=True, text=True, env=env, timeout=300, cwd=ROOT)
+
+
+@pytest.mark.parametrize("ranks", [1, 2, 4])
+def test_slab_pair_matches_numpy(ranks, tmp_path):
+    done = run_driver(ranks, tmp_path)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "worst" in done.stdout
+
+
+def test_column_split_is_balanced():
+    starts, counts = column_split(1025, 2)
+    assert list(counts) == [513, 512] and list(starts) == [0, 513]
+    starts, counts = column_split(6, 4)
+    assert list(counts) == [2, 2, 1, 1] and list(starts) == [0, 2, 4, 5]
+
+
+def test_one_rank_in_process_and_bad_sizes():
+    from mpi4py import MPI
+
+    grid = Grid(16, 12)
+    transform = SlabTransform(grid, MPI.COMM_SELF, "FFTW_ESTIMATE")
+    try:
+        x = np.random.default_rng(1).random(grid.shape)
+        assert transform.local_rows == slice(0, 16)
+        assert np.abs(transform.forward(x) - np.fft.rfft2(x)).max() <= 1e-13 * np.abs(x).sum()
+    finally:
+        transform.destroy()
+    with pytest.raises(ValueError):
+        SlabTransform(Grid(16, 12), MPI.COMM_SELF, "FFTW_ESTIMATE", exchange="ring")
