@@ -2,7 +2,7 @@
 
     .venv/bin/python studies/mpi_speedup.py [--n 2048] [--pair-sizes 1024,2048] [--rounds 3]
                                             [--solve-rounds 3] [--no-solve] [--ranks 2]
-                                            [--transforms current,slab] [--variants base|all|LIST]
+                                            [--transforms current,mpi4py-fft] [--variants base|all|LIST]
 
 One run launches ``mpiexec -n 1`` and ``mpiexec -n RANKS`` workers (this script with ``--worker``),
 alternating the rank counts round after round because the machine is shared and noisy, and takes
@@ -19,13 +19,15 @@ Pair workers (at each N of --pair-sizes), one r2c + c2r pair each, no symbol mul
   (SIGSEGV) in a process that also uses pyFFTW plans;
 - ``slab/shared``, ``slab/alltoall``: :class:`roughpetsc.slab.SlabTransform` with its two exchanges;
 - ``shell``: one MatMult of ``Westergaard(Grid(n, n), 1.0, COMM_WORLD).mat()`` as
-  ``roughpetsc.westergaard`` is; ``shell+slab``: the same with the multi-rank transform replaced by
-  :class:`~roughpetsc.slab.SlabTransform` (what the integration gives; identical on one rank).
+  ``roughpetsc.westergaard`` is (1 rank: direct 2-D plan; several: :class:`roughpetsc.slab.SlabTransform`);
+  ``shell/mpi4py-fft``: the same with the old multi-rank transform, ``westergaard._SlabTransform``
+  (mpi4py-fft PFFT), for comparison (its 1-rank time is ``shell``'s).
 
 Solve workers: one cold load-controlled solve of the group-1 surface (N = --n, k_l = 16, k_s = 64,
 H = 0.8, m2 = 2e-4, seed 1, E* = 1) at p* = 0.5 to a natural KKT residual of 1e-8 with the default
 solver (``Solver(problem, "load", None, 1e-8)``), ``Result.time_s`` (the solve only, no set-up), with
-the transform as it is (``current``) and with :class:`~roughpetsc.slab.SlabTransform` (``slab``).
+the transform as it is (``current``) and with the old mpi4py-fft one (``mpi4py-fft``); the table names
+the transform class each run used.
 
 Prints and writes studies/output/mpi_speedup.md: pair times, speed-ups (1 rank / RANKS ranks; the
 solve's 1-rank time always uses the direct 2-D plan), and the SPEC ratio
@@ -34,6 +36,7 @@ machine is recorded around every worker.
 """
 
 import argparse
+import contextlib
 import json
 import os
 import statistics
@@ -46,17 +49,36 @@ sys.path.insert(0, ROOT)
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
            "OMPI_MCA_rmaps_base_oversubscribe": "1", "OMPI_MCA_btl_vader_single_copy_mechanism": "none"}
 BASE_VARIANTS = ["fftw2d", "mpi4py-fft", "mpi4py-fft/fftw", "mpi4py-fft/collapse", "slab/shared",
-                 "slab/alltoall", "shell", "shell+slab"]
+                 "slab/alltoall", "shell", "shell/mpi4py-fft"]
 ALL_VARIANTS = BASE_VARIANTS + ["mpi4py-fft/patient"]
 
 
 # --------------------------------------------------------------------------- workers (under mpiexec)
-def _use_slab_transform():
-    """Make roughpetsc.westergaard build its multi-rank transform with roughpetsc.slab (what-if)."""
+@contextlib.contextmanager
+def _transform(name):
+    """Within the block, Westergaard builds its multi-rank transform as ``name`` says (what-if runs).
+
+    ``current``: as roughpetsc.westergaard is; ``mpi4py-fft``: its kept ``_SlabTransform`` (mpi4py-fft
+    PFFT), swapped in for roughpetsc.slab.SlabTransform, which westergaard imports when it builds one.
+    """
     from roughpetsc import slab, westergaard
 
-    if getattr(westergaard, "_SlabTransform", None) is not slab.SlabTransform:
-        westergaard._SlabTransform = slab.SlabTransform
+    if name == "current":
+        yield
+        return
+    if name != "mpi4py-fft" or not hasattr(westergaard, "_SlabTransform"):
+        raise ValueError(f"unknown transform {name!r}")
+    kept = slab.SlabTransform
+    slab.SlabTransform = westergaard._SlabTransform
+    try:
+        yield
+    finally:
+        slab.SlabTransform = kept
+
+
+def _label(transform):
+    exchange = getattr(transform, "exchange", None)
+    return type(transform).__name__ + (f"({exchange})" if exchange else "")
 
 
 class _Pair:
@@ -71,6 +93,7 @@ class _Pair:
 
         rng = np.random.default_rng(comm.Get_rank())
         self._destroy = []
+        self.label = None
         grid = Grid(n, n)
         if name == "fftw2d":
             real = pyfftw.empty_aligned((n, n), dtype="float64")
@@ -112,12 +135,12 @@ class _Pair:
                 transform.forward(real)
                 transform.backward(real)
             self._destroy.append(transform.destroy)
-        elif name in ("shell", "shell+slab"):
+        elif name in ("shell", "shell/mpi4py-fft"):
             from roughpetsc import westergaard
 
-            if name == "shell+slab":
-                _use_slab_transform()
-            operator = westergaard.Westergaard(grid, 1.0, PETSc.COMM_WORLD)
+            with _transform("current" if name == "shell" else "mpi4py-fft"):
+                operator = westergaard.Westergaard(grid, 1.0, PETSc.COMM_WORLD)
+            self.label = _label(operator._transform)
             mat = operator.mat()
             x, y = operator.vec(), operator.vec()
             x.setRandom()
@@ -141,7 +164,7 @@ def worker_pairs(n, variants, repeats):
     comm = MPI.COMM_WORLD
     size = comm.Get_size()
     variants = [v for v in variants if not (v == "fftw2d" and size > 1)
-                and not (v == "shell+slab" and size == 1)]
+                and not (v == "shell/mpi4py-fft" and size == 1)]
     pairs = {}
     for name in variants:
         pairs[name] = _Pair(name, n, comm)
@@ -156,13 +179,14 @@ def worker_pairs(n, variants, repeats):
             comm.Barrier()
             times[name].append(MPI.Wtime() - start)
             cpu[name].append(time.process_time() - start_cpu)
-    for pair in pairs.values():
-        pair.destroy()
     out = {name: statistics.median(t) for name, t in times.items()}
+    out["labels"] = {name: pair.label for name, pair in pairs.items() if pair.label}
     for name, t in cpu.items():  # the CPU time of the busiest rank: the wall time on an idle machine
         busiest = np.empty(len(t))
         comm.Allreduce(np.array(t), busiest, op=MPI.MAX)
         out["cpu:" + name] = float(np.median(busiest))
+    for pair in pairs.values():
+        pair.destroy()
     return out
 
 
@@ -174,11 +198,11 @@ def worker_solve(n, transform):
     from roughpetsc.control import Solver
     from roughpetsc.surfaces import Grid, fractal
 
-    if transform == "slab":
-        _use_slab_transform()
     grid = Grid(n, n)
     heights = fractal(grid, 16.0, 64.0, 0.8, 2e-4, 1)
-    problem = ContactProblem(grid, heights, 1.0, PETSc.COMM_WORLD)
+    with _transform(transform):
+        problem = ContactProblem(grid, heights, 1.0, PETSc.COMM_WORLD)
+    label = _label(problem.operator._transform)
     solver = Solver(problem, "load", None, 1e-8)
     try:
         start_cpu = time.process_time()
@@ -187,7 +211,7 @@ def worker_solve(n, transform):
     finally:
         solver.destroy()
         problem.destroy()
-    return {"time_s": result.time_s, "cpu_s": cpu, "iterations": result.iterations,
+    return {"time_s": result.time_s, "cpu_s": cpu, "class": label, "iterations": result.iterations,
             "applications": result.operator_applications, "natural": result.kkt.natural,
             "converged": bool(result.converged), "A": result.A, "gstar": result.gstar, "solver": result.solver}
 
@@ -242,8 +266,8 @@ def main():
     parser.add_argument("--rounds", type=int, default=3, help="pair workers per rank count and size")
     parser.add_argument("--repeats", type=int, default=15, help="timed pairs per variant per worker")
     parser.add_argument("--solve-rounds", type=int, default=3, help="solves per rank count and transform")
-    parser.add_argument("--transforms", default="current,slab",
-                        help="multi-rank transforms of the solve: current (as westergaard is) and/or slab")
+    parser.add_argument("--transforms", default="current,mpi4py-fft",
+                        help="multi-rank transforms of the solve: current (as westergaard is) and/or mpi4py-fft")
     parser.add_argument("--no-solve", action="store_true")
     parser.add_argument("--variants", default="base", help="base, all, or a comma list")
     parser.add_argument("--report", default=os.path.join(ROOT, "studies", "output", "mpi_speedup.md"))
@@ -259,6 +283,7 @@ def main():
     sizes = [int(s) for s in args.pair_sizes.split(",")] if args.pair_sizes else sorted({1024, args.n})
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     loads = []
+    labels = {}  # transform class of the shell variants on RANKS ranks
     pairs = {(n, r): [] for n in sizes for r in ranks}
     for k in range(args.rounds):
         for n in sizes:
@@ -267,6 +292,9 @@ def main():
                 for group in worker_groups(args.variants):
                     part, load = launch(r, ["--worker", "pairs", "--n", str(n), "--variants", ",".join(group),
                                             "--repeats", str(args.repeats)])
+                    found = part.pop("labels")
+                    if r > 1:
+                        labels.update(found)
                     out.update(part)
                     loads.append(load)
                 pairs[n, r].append(out)
@@ -288,7 +316,7 @@ def main():
                       f"CPU {out['cpu_s']:.2f} s, {out['iterations']} its, {out['applications']} K, "
                       f"KKT {out['natural']:.1e}, A={out['A']:.6f}  (load {load:.2f})", flush=True)
 
-    lines = report(args, sizes, ranks, pair, solves, loads, started)
+    lines = report(args, sizes, ranks, pair, solves, loads, started, labels)
     print("\n".join(lines))
     os.makedirs(os.path.dirname(args.report), exist_ok=True)
     with open(args.report, "w") as f:
@@ -310,14 +338,14 @@ def _pair_table(pair, sizes, ranks, prefix):
                  for n in sizes for r in ranks]
         speed = []
         for n in sizes:
-            serial = pair[n, one].get(prefix + (v if v != "shell+slab" else "shell"))
+            serial = pair[n, one].get(prefix + (v if v != "shell/mpi4py-fft" else "shell"))
             parallel = pair[n, many].get(prefix + v)
             speed.append(f"{serial / parallel:.2f}" if serial and parallel else "")
         lines.append(f"| {v} | " + " | ".join(cells) + " | " + " | ".join(speed) + " |")
     return lines
 
 
-def report(args, sizes, ranks, pair, solves, loads, started):
+def report(args, sizes, ranks, pair, solves, loads, started, labels):
     one, many = ranks
     lines = [f"# MPI speed-up on {many} ranks (`studies/mpi_speedup.py`)", "",
              f"Run {started}, {os.cpu_count()} cores, 1-minute load average around the workers "
@@ -329,9 +357,11 @@ def report(args, sizes, ranks, pair, solves, loads, started):
     lines += ["", "## The same pairs: CPU time of the busiest rank (ms)", "",
               "What the wall time would be on an otherwise idle machine (waiting in MPI spins, so it counts).", ""]
     lines += _pair_table(pair, sizes, ranks, "cpu:")
-    lines += ["", "Speed-up = 1-rank time / %d-rank time of the same row; for `shell+slab` the 1-rank time is "
-              "`shell`'s (on one rank the shell Mat uses the direct 2-D plan whatever the multi-rank "
-              "transform). The SPEC's bare distributed pair is the `mpi4py-fft` row." % many]
+    lines += ["", "Speed-up = 1-rank time / %d-rank time of the same row; `shell` is one MatMult of the Westergaard "
+              "shell Mat (1 rank: direct 2-D FFTW plan; %d ranks: %s), `shell/mpi4py-fft` the same with the old "
+              "mpi4py-fft transform (its 1-rank time is `shell`'s). `slab/*` is roughpetsc.slab.SlabTransform "
+              "with each exchange. The SPEC's bare distributed pair is the `mpi4py-fft` row."
+              % (many, many, labels.get("shell", "?"))]
     if solves:
         n = args.n
         lines += ["", f"## One load-controlled solve, N={n}, p*=0.5, natural KKT 1e-8 (default solver)", "",
@@ -349,7 +379,7 @@ def report(args, sizes, ranks, pair, solves, loads, started):
         serial, serial_k, serial_cpu_k = medians(solves[one, "current"])
         for (r, transform), outs in sorted(solves.items()):
             t, per_k, cpu_k = medians(outs)
-            lines.append(f"| {r} | {transform if r > 1 else 'fftw2d'} | "
+            lines.append(f"| {r} | {transform} = {outs[-1]['class']} | "
                          + ", ".join(f"{o['time_s']:.1f}" for o in outs) + " | "
                          + ", ".join(str(o["iterations"]) for o in outs) + " | "
                          + ", ".join(str(o["applications"]) for o in outs)
