@@ -416,7 +416,7 @@ class Solver:
             self.name = f"pk({self.backend.context.preconditioner})"
         self.pressure = problem.vec()
         self.pressure.set(0.0)
-        self.previous = problem.vec()  # the solution before the last, for the load-path predictor
+        self.previous = None  # the solution before the last, for the load-path predictor (load paths only)
         self.gap = problem.vec()
         self.last_separation = None
         self.solved_targets = []  # scaled loads of the solutions in (previous, pressure)
@@ -456,6 +456,8 @@ class Solver:
         is then scaled to the new mean pressure. After one, that solution is
         scaled; with none, the start is uniform.
         """
+        if self.solved_targets and self.previous is None:
+            self.previous = self.problem.vec()
         if len(self.solved_targets) == 2:
             older, newer = self.solved_targets
             if newer != older:
@@ -466,7 +468,7 @@ class Solver:
                 self.pressure, self.previous = self.previous, self.pressure
                 local = self.problem.local(self.pressure)
                 np.maximum(local, 0.0, out=local)
-        else:
+        elif self.solved_targets:
             self.pressure.copy(self.previous)
         mean_p = self.pressure.sum() / self.problem.n
         if mean_p > 0:
@@ -508,5 +510,6 @@ class Solver:
     def destroy(self):
         self.backend.destroy()
         self.pressure.destroy()
-        self.previous.destroy()
+        if self.previous is not None:
+            self.previous.destroy()
         self.gap.destroy()

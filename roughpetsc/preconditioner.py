@@ -61,18 +61,21 @@ class FourierPreconditioner:
         """``out = B residual`` on local flat arrays; ``residual`` vanishes off the contact set.
 
         ``contact`` is 1.0 on C and 0.0 elsewhere, ``count`` the global |C|.
-        ``keep_load``: drop the mean-mode term (load control: directions keep
-        the mean pressure).
+        ``keep_load``: load control; the residual must then have zero mean on
+        C, and the mean-mode term is dropped (directions keep the mean pressure).
         """
         problem = self.problem
         operator = problem.operator
-        residual_sum, = allsum(problem.mpi, [residual.sum()])
-        residual_mean = residual_sum / count
-        if residual_mean:  # P residual, undone below (the caller keeps its residual)
-            residual -= residual_mean * contact
-        operator.stiffness(residual.reshape(operator.local_shape), out.reshape(operator.local_shape))
-        if residual_mean:
-            residual += residual_mean * contact
+        shape = operator.local_shape
+        if keep_load:
+            # The caller's residual has zero mean on C already (load control): P residual = residual.
+            operator.stiffness(residual.reshape(shape), out.reshape(shape))
+        else:
+            residual_sum, = allsum(problem.mpi, [residual.sum()])
+            residual_mean = residual_sum / count
+            np.multiply(contact, -residual_mean, out=out)
+            out += residual  # P residual, built in out: the FFT pair may run in place
+            operator.stiffness(out.reshape(shape), out.reshape(shape))
         out *= contact
         out_sum, = allsum(problem.mpi, [out.sum()])
         out -= out_sum / count

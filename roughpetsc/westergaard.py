@@ -164,18 +164,14 @@ class Westergaard:
     def vec(self):
         """A new distributed Vec laid out like the grid (rows owned by this rank).
 
-        On one rank its memory is SIMD-aligned, so that the FFTW plans run on it
-        in place (no copy per application).
+        Its memory is SIMD-aligned, so that the FFTW plans (serial or slab) run
+        on it in place (no copy per application).
         """
-        n_local = self.local_shape[0] * self.local_shape[1]
-        if self.comm.getSize() == 1:
-            import pyfftw
+        import pyfftw
 
-            return PETSc.Vec().createWithArray(pyfftw.zeros_aligned(n_local, dtype="float64"), comm=self.comm)
-        v = PETSc.Vec().create(comm=self.comm)
-        v.setSizes((n_local, self.grid.size))
-        v.setUp()
-        return v
+        n_local = self.local_shape[0] * self.local_shape[1]
+        return PETSc.Vec().createWithArray(pyfftw.zeros_aligned(n_local, dtype="float64"),
+                                           size=(n_local, self.grid.size), comm=self.comm)
 
     def local(self, v, readonly=False):
         """This rank's part of ``v`` as a ``(rows, n1)`` array view."""
