@@ -34,6 +34,8 @@ SOLVE_OPTIONS = [
     ("json", "", "write a JSON summary (surface statistics, one entry per load step) to PATH"),
     ("output", "", "write an HDF5 file with heights, pressure and gap fields of the last step to PATH"),
     ("pk_pc", "fourier", "Polonsky-Keer preconditioner: fourier (inverse symbol pi E*|k| on the contact set) | none"),
+    ("pk_active_set", "bccg", "Polonsky-Keer active set: bccg (overlapping nodes join the free set, Polak-Ribiere "
+                              "without restarts) | pk (as published: nodes enter after the step, CG restarts)"),
     ("pk_refresh", 50, "Polonsky-Keer: recompute K p from scratch at least every this many iterations"),
     ("bound_pc", "", "TAO bnls/bntr/bntl/tron/gpcg: fourier (inverse symbol on the free set; default of the BNK "
                      "types) | none (default of tron, gpcg) | options (-tao_*pc_type decides)"),
@@ -43,9 +45,9 @@ SOLVE_OPTIONS = [
 ]
 
 SOLVER_HELP = """Solvers (PETSc options):
-  (no -tao_type)          Polonsky-Keer projected CG (TAO type python), preconditioned by the inverse Westergaard
-                          symbol (-pk_pc fourier, the default); load control (-pstar/-pbar) or displacement
-                          control (-gbar)
+  (no -tao_type)          Polonsky-Keer projected CG (TAO type python) with the bound-constrained active set
+                          (-pk_active_set bccg), preconditioned by the inverse Westergaard symbol (-pk_pc fourier);
+                          load control (-pstar/-pbar) or displacement control (-gbar)
   -tao_type <bound type>  blmvm bqnls bncg bqnkls bqnktr bnls bntr tron gpcg: displacement control directly,
                           load control by a safeguarded root find on the mean gap around that type
   -tao_type almm          load control by TAO ALMM (-tao_almm_subsolver_tao_type bqnls|blmvm|...)

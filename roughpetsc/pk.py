@@ -1,22 +1,35 @@
 """Polonsky-Keer constrained conjugate gradients, as a TAO ``python`` type.
 
 Polonsky and Keer, Wear 231 (1999): CG on the contact set with the mean gap
-there removed (which fixes the rigid separation), a restart whenever nodes
-enter the contact set, projection onto p >= 0 and rescaling to the prescribed
-mean pressure after each step. Under displacement control (d prescribed) the
-same projected CG runs with d fixed and without the rescaling.
+there removed (which fixes the rigid separation), projection onto p >= 0 and
+rescaling to the prescribed mean pressure after each step. Under displacement
+control (d prescribed) the same projected CG runs with d fixed and without
+the rescaling.
+
+Active-set strategy (``-pk_active_set``):
+
+- ``bccg`` (the default): the bound-constrained CG of Vollebregt (J. Optim.
+  Theory Appl. 162, 2014). The free set is the contact set plus the nodes out
+  of contact whose gap is negative, so the search direction itself pushes
+  overlapping nodes into contact; steps crossing p = 0 are truncated by the
+  projection, and CG continues with the Polak-Ribiere beta (clipped at 0)
+  instead of restarting.
+- ``pk``: as published. Overlapping nodes enter with p = -step g after the
+  step and CG restarts whenever any did; the contact set grows by a rim of
+  nodes per restart, which is what makes PK slow to find it.
 
 Preconditioning (``-pk_pc fourier``, the default): plain PK needs O(N)
 iterations because K is ill-conditioned on the contact set; the search
 direction is built from ``z = B r`` instead of the residual ``r``, with ``B``
 the Fourier preconditioner of :mod:`roughpetsc.preconditioner` (preconditioned
-CG on the active set, as Vollebregt, J. Comput. Phys. 257, 2014, without his
-deflation). It costs one more FFT pair per iteration.
+CG on the free set, as Vollebregt, J. Comput. Phys. 257, 2014, without his
+deflation). It costs one more FFT pair per iteration. ``-pk_pc none
+-pk_active_set pk`` is the published algorithm.
 
 Operator applications: the step needs ``K t``; the gap of the new iterate is
-then updated as ``K p <- s (K p - step K t)`` whenever the projection and the
-re-entry of nodes changed nothing, and recomputed with a fresh ``K p``
-otherwise, every ``-pk_refresh`` iterations, and before convergence is
+then updated as ``K p <- s (K p - step K t)`` whenever the projection (and,
+under PK, the entry of nodes) changed nothing, and recomputed with a fresh
+``K p`` otherwise, every ``-pk_refresh`` iterations, and before convergence is
 declared (the stopping rule is always checked on a freshly computed gap).
 
 The stopping rule is the natural KKT residual of :mod:`roughpetsc.kkt`.
@@ -32,6 +45,7 @@ from .kkt import History, allsum, report
 from .preconditioner import FourierPreconditioner
 
 PRECONDITIONERS = ("none", "fourier")
+ACTIVE_SETS = ("pk", "bccg")
 
 
 
@@ -43,8 +57,9 @@ class PolonskyKeer:
     (displacement control, scaled rigid separation d): then the same projected
     CG runs with d fixed, no mean removal and no rescaling.
 
-    Options (read by :meth:`configure`): ``-pk_pc none|fourier`` and
-    ``-pk_refresh N`` (recompute ``K p`` at least every N iterations).
+    Options (read by :meth:`configure`): ``-pk_pc none|fourier``,
+    ``-pk_active_set bccg|pk`` and ``-pk_refresh N`` (recompute ``K p`` at
+    least every N iterations).
     """
 
     def __init__(self, problem, rtol):
@@ -55,13 +70,14 @@ class PolonskyKeer:
         self.separation = 0.0
         self.preconditioner = "fourier"
         self.refresh = 50
+        self.active_set = "bccg"
         self.max_seconds = 0.0
         self.history = None
-        self.vecs = [problem.vec() for _ in range(5)]
+        self.vecs = [problem.vec() for _ in range(6)]
         self.fourier = FourierPreconditioner(problem)
 
     def configure(self):
-        """Read ``-pk_pc`` and ``-pk_refresh``.
+        """Read ``-pk_pc``, ``-pk_active_set`` and ``-pk_refresh``.
 
         Called before the TAO is set up: an exception raised inside a TAO
         callback would leave PETSc's options block open and crash at exit.
@@ -72,11 +88,14 @@ class PolonskyKeer:
             raise UserError(f"-pk_pc: unknown preconditioner '{self.preconditioner}' "
                             f"(one of {', '.join(PRECONDITIONERS)})")
         self.refresh = options.getInt("pk_refresh", self.refresh)
+        self.active_set = options.getString("pk_active_set", self.active_set)
+        if self.active_set not in ACTIVE_SETS:
+            raise UserError(f"-pk_active_set: unknown strategy '{self.active_set}' (one of {', '.join(ACTIVE_SETS)})")
         if self.refresh < 1:
             raise UserError(f"-pk_refresh must be a positive number of iterations, got {self.refresh}")
 
     def view(self, tao, viewer):
-        viewer.printfASCII(f"  Polonsky-Keer CG, preconditioner {self.preconditioner}, "
+        viewer.printfASCII(f"  Polonsky-Keer CG, active set {self.active_set}, preconditioner {self.preconditioner}, "
                            f"K p refreshed every {self.refresh} iterations\n")
 
     def destroy(self, tao=None):
@@ -103,6 +122,9 @@ class PolonskyKeer:
         response = problem.local(response_vec).ravel()  # K t, then scratch
         gap = problem.local(self.vecs[3]).ravel()
         z = problem.local(self.vecs[4]).ravel()  # preconditioned residual
+        r_old = problem.local(self.vecs[5]).ravel()
+        r_old[...] = 0.0
+        bccg = self.active_set == "bccg"
         precondition = self.preconditioner == "fourier"
         contact = np.empty_like(p)  # 1.0 on the contact set, 0.0 elsewhere: masks as dot products
         t[...] = 0.0
@@ -110,7 +132,7 @@ class PolonskyKeer:
             self.separation = self.target_separation
             self._interference_start(pressure, p, h)
         self.history = History(operator)
-        self.restarts = 0  # CG restarts: iterations where nodes entered the contact set
+        self.restarts = 0  # CG restarts: PK, nodes entered the contact set; BCCG, Polak-Ribiere beta <= 0
         max_it = tao.getMaximumIterations()
         rz_old, conjugate, fresh_needed = 1.0, False, True
         since_fresh = 0
@@ -142,20 +164,35 @@ class PolonskyKeer:
             if self.history.out_of_time(self.max_seconds):
                 reason = PETSc.TAO.Reason.DIVERGED_USER
                 break
-            # Residual on the contact set, preconditioned and restricted to it again.
+            # The free set: the contact set, and under BCCG also the nodes out of contact that overlap.
+            if bccg:
+                np.copyto(contact, 1.0, where=gap < 0)
+            count, gap_sum = allsum(mpi, [contact.sum(), np.dot(gap, contact)])
             r = response
-            np.multiply(gap, contact, out=r)
+            if load_control:
+                # Directions keep the load: the residual has zero mean on the free set.
+                np.subtract(gap, gap_sum / count, out=r)
+                r *= contact
+            else:
+                np.multiply(gap, contact, out=r)
             if precondition:
-                if not load_control:
-                    count, = allsum(mpi, [contact.sum()])
                 self.fourier.apply(r, z, contact, count, keep_load=load_control)
                 direction = z
             else:
                 direction = r
-            rz, = allsum(mpi, [np.dot(r, direction)])
-            # Conjugate direction on the contact set: t = z + beta t_c.
+            if bccg:
+                # Polak-Ribiere (clipped at 0): conjugacy survives changes of the free set.
+                rz, r_old_z = allsum(mpi, [np.dot(r, direction), np.dot(r_old, direction)])
+                beta = (rz - r_old_z) / rz_old if iteration else 0.0
+                self.restarts += iteration > 0 and beta <= 0.0
+                beta = max(beta, 0.0)
+                np.copyto(r_old, r)
+            else:
+                rz, = allsum(mpi, [np.dot(r, direction)])
+                beta = rz / rz_old if conjugate else 0.0
+            # Conjugate direction on the free set: t = z + beta t.
             t *= contact
-            t *= rz / rz_old if conjugate else 0.0
+            t *= beta
             t += direction
             rz_old = rz
             operator.displacement(direction_vec, response_vec)
@@ -172,16 +209,20 @@ class PolonskyKeer:
             displacement += response
             np.multiply(t, step, out=response)
             p -= response
-            # Projection onto p >= 0; nodes out of contact that the gap says overlap re-enter; then restart CG.
+            # Projection onto p >= 0; under PK, nodes out of contact that overlap enter and CG restarts.
             clipped = np.count_nonzero(p < 0)
             np.maximum(p, 0.0, out=p)
-            overlap = (gap < 0) & (p == 0)
-            changed, entering = allsum(mpi, [clipped, np.count_nonzero(overlap)])
-            if entering:
-                np.multiply(gap, -step, out=response)
-                np.copyto(p, response, where=overlap)
-            conjugate = entering == 0
-            self.restarts += not conjugate
+            if bccg:
+                changed, = allsum(mpi, [clipped])
+                entering = 0
+            else:
+                overlap = (gap < 0) & (p == 0)
+                changed, entering = allsum(mpi, [clipped, np.count_nonzero(overlap)])
+                if entering:
+                    np.multiply(gap, -step, out=response)
+                    np.copyto(p, response, where=overlap)
+                conjugate = entering == 0
+                self.restarts += not conjugate
             if load_control:
                 total, = allsum(mpi, [p.sum()])
                 scale = pbar * n / total

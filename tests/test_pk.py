@@ -22,8 +22,9 @@ def problem():
     problem.destroy()
 
 
-def solve(problem, control, tao_type, preconditioner, rtol, **load):
+def solve(problem, control, tao_type, preconditioner, rtol, active_set="bccg", **load):
     PETSc.Options().setValue("pk_pc", preconditioner)
+    PETSc.Options().setValue("pk_active_set", active_set)
     solver = Solver(problem, control, tao_type, rtol)
     try:
         result = solver.solve(**load)
@@ -31,6 +32,7 @@ def solve(problem, control, tao_type, preconditioner, rtol, **load):
     finally:
         solver.destroy()
         PETSc.Options().delValue("pk_pc")
+        PETSc.Options().delValue("pk_active_set")
 
 
 # Sparse early contact (small islands) gains least from the Fourier preconditioner.
@@ -44,6 +46,21 @@ def test_preconditioned_load_control_matches_plain_pk_in_fewer_iterations(proble
     assert fourier.A == plain.A
     assert fourier.gbar == pytest.approx(plain.gbar, rel=1e-8)
     assert fourier.iterations < iteration_ratio * plain.iterations
+
+
+@pytest.mark.parametrize("control, load", [("load", {"pstar": 0.05}), ("load", {"pstar": 0.5}),
+                                           ("displacement", {"gbar": 0.6})])
+@pytest.mark.parametrize("preconditioner", ["none", "fourier"])
+def test_bccg_active_set_matches_published_pk_in_fewer_iterations(problem, control, load, preconditioner):
+    """BCCG and PK's restart rule reach the same solution; BCCG in fewer iterations."""
+    if control == "displacement":
+        load = {"gbar": load["gbar"] * problem.height_scale}
+    published, published_field = solve(problem, control, None, preconditioner, 1e-10, active_set="pk", **load)
+    bccg, bccg_field = solve(problem, control, None, preconditioner, 1e-10, active_set="bccg", **load)
+    assert published.converged and bccg.converged
+    assert np.abs(bccg_field - published_field).max() <= 1e-7 * published_field.max()
+    assert bccg.A == published.A
+    assert bccg.iterations < published.iterations
 
 
 @pytest.mark.parametrize("preconditioner", ["none", "fourier"])
@@ -66,6 +83,17 @@ def test_unknown_preconditioner_is_a_user_error(problem):
             Solver(problem, "load", None, 1e-8)
     finally:
         PETSc.Options().delValue("pk_pc")
+
+
+def test_unknown_active_set_is_a_user_error(problem):
+    from roughpetsc.errors import UserError
+
+    PETSc.Options().setValue("pk_active_set", "greedy")
+    try:
+        with pytest.raises(UserError, match="-pk_active_set"):
+            Solver(problem, "load", None, 1e-8)
+    finally:
+        PETSc.Options().delValue("pk_active_set")
 
 
 def test_fourier_preconditioner_is_symmetric_positive_definite_on_a_free_set():
