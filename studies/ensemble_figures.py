@@ -656,7 +656,7 @@ def acceptance(ensembles, produced, report):
         fit_dev = np.max(np.abs(grid["A"]["inf"][sel] - M.curvefit_area(grid["p"][sel], grid["alpha_p"], b, c, d)))
         b2, c2, d2 = M.fit_curvefit(grid["p"], grid["A"]["inf"], M.ALPHA_P_TABLE_8_3[18])
         sb, sc, sd = M.TABLE_8_4[18]
-        report.append(f"| 18 extrapolated (2 A_1024 - A_512) | h -> 0 | — | {b:.3f} | {sb:.3f} | {c:.3f} | {sc:.3f} | "
+        report.append(f"| 18 extrapolated (2 A_{grid['extrapolation'][0]} - A_{grid['extrapolation'][1]}) | h -> 0 | — | {b:.3f} | {sb:.3f} | {c:.3f} | {sc:.3f} | "
                       f"{d:.4f} | {sd:.3f} | {fit_dev:.4f} | {b2:.3f}, {c2:.3f}, {d2:.4f} |")
     at512 = [f for f in fits if f[0].N == 512]
     if len(at512) > 1:
@@ -706,8 +706,8 @@ def acceptance(ensembles, produced, report):
                 color=c, label=f"#{e.group} ({e.N}^2, {e.n})")
     grid = grid_effect(ensembles)
     if grid is not None:
-        p, dev512, dev1024, dev_inf = grid["p"], grid["dev"][512], grid["dev"][1024], grid["dev"]["inf"]
-        ax.plot(p, dev_inf, "k--", lw=1.2, label="#18 extrapolated to h -> 0 (2 A_1024 - A_512)")
+        ax.plot(grid["p"], grid["dev"]["inf"], "k--", lw=1.2, label="#18 extrapolated to h -> 0 (2 A_%d - A_%d)"
+                % grid["extrapolation"])
     for y in (-TOLERANCE, TOLERANCE):
         ax.axhline(y, color="r", ls="--", lw=0.8)
     ax.set(xlabel="p*", ylabel="A*_mean - I(p*) f(p*)", title="Acceptance: BEM mean minus the seed's curve fit")
@@ -717,11 +717,12 @@ def acceptance(ensembles, produced, report):
     if grid is not None:
         report += ["### Grid effect (group 18)", "",
                    "Node-count A* carries a discretisation error of the order of the contact perimeter times the "
-                   "node spacing h. Group 18 on 512^2 and on the seed's 1024^2, compared at their shared steps "
-                   f"({grid['p'].size} steps in [{P_RANGE[0]:g}, {P_RANGE[1]:g}]); \"extrapolated\" is the "
-                   "Richardson estimate 2 A*_1024 - A*_512 of the h -> 0 limit (error assumed proportional to h).", "",
+                   "node spacing h. Group 18 on each grid it ran on (the seed's is 1024^2), compared at their shared "
+                   f"steps ({grid['p'].size} steps in [{P_RANGE[0]:g}, {P_RANGE[1]:g}]); \"extrapolated\" is the "
+                   "Richardson estimate 2 A*_fine - A*_coarse of the h -> 0 limit from the two finest grids "
+                   "(error assumed proportional to h).", "",
                    "| A* from | max abs(A* - I f) (seed's curve) | at p* | perimeter-corrected |", "|---|---|---|---|"]
-        for key, label in ((512, "512^2 mean"), (1024, "1024^2 mean"), ("inf", "extrapolated h -> 0")):
+        for key, label in grid["labels"]:
             dev, devc = grid["dev"][key], grid["dev_corrected"][key]
             k = int(np.argmax(np.abs(dev)))
             report.append(f"| {label} | {abs(dev[k]):.4f} | {grid['p'][k]:.3f} | {np.max(np.abs(devc)):.4f} |")
@@ -730,20 +731,26 @@ def acceptance(ensembles, produced, report):
 
 
 def grid_effect(ensembles):
-    """Group 18 at 512^2 and 1024^2: deviations from the seed's curve at the shared steps, and the
-    Richardson extrapolation 2 A_1024 - A_512."""
-    e512, e1024 = ensembles.get((18, 512)), ensembles.get((18, 1024))
-    if e512 is None or e1024 is None:
+    """Group 18 on every grid it ran on (at least two): deviations from the seed's curve at the shared steps,
+    and the Richardson extrapolation 2 A_fine - A_coarse from the two finest grids (error ~ h)."""
+    runs = {n: e for (group, n), e in sorted(ensembles.items()) if group == 18}
+    if len(runs) < 2:
         return None
-    p, (i512, i1024) = common_steps([e512, e1024])
+    grids = sorted(runs)
+    p, indices = common_steps([runs[n] for n in grids])
     sel = (p >= P_RANGE[0] - 1e-12) & (p <= P_RANGE[1] + 1e-12)
-    p, i512, i1024 = p[sel], i512[sel], i1024[sel]
+    p = p[sel]
+    indices = [i[sel] for i in indices]
     I_f = seed_curve(p, 18, M.ALPHA_P_TABLE_8_3[18])
-    A = {512: e512.A[i512], 1024: e1024.A[i1024]}
-    Ac = {512: e512.Ac[i512], 1024: e1024.Ac[i1024]}
-    A["inf"], Ac["inf"] = 2 * A[1024] - A[512], 2 * Ac[1024] - Ac[512]
-    return {"p": p, "A": A, "dev": {k: v - I_f for k, v in A.items()},
-            "dev_corrected": {k: v - I_f for k, v in Ac.items()}, "alpha_p": 0.5 * (e512.alpha_p + e1024.alpha_p)}
+    A = {n: runs[n].A[i] for n, i in zip(grids, indices)}
+    Ac = {n: runs[n].Ac[i] for n, i in zip(grids, indices)}
+    coarse, fine = grids[-2:]
+    A["inf"], Ac["inf"] = 2 * A[fine] - A[coarse], 2 * Ac[fine] - Ac[coarse]
+    labels = [(n, f"{n}^2 mean ({runs[n].n} surfaces)") for n in grids] + \
+        [("inf", f"extrapolated h -> 0 (2 A_{fine} - A_{coarse})")]
+    return {"p": p, "A": A, "dev": {k: v - I_f for k, v in A.items()}, "labels": labels,
+            "dev_corrected": {k: v - I_f for k, v in Ac.items()}, "extrapolation": (fine, coarse),
+            "alpha_p": float(np.mean([runs[n].alpha_p for n in grids[-2:]]))}
 
 
 def notes(ensembles, report):
@@ -857,8 +864,7 @@ def main():
     if grid is not None:
         dev = grid["dev"]
         summary.append("- Group 18 grid effect: max deviation "
-                       + ", ".join(f"{label} {np.max(np.abs(dev[key])):.4f}" for key, label in
-                                   ((512, "512^2"), (1024, "1024^2"), ("inf", "extrapolated h -> 0")))
+                       + ", ".join(f"{label} {np.max(np.abs(dev[key])):.4f}" for key, label in grid["labels"])
                        + " (see 'Grid effect' below)")
     summary.append("")
     report = head + summary + body + tail + ["## Figures", ""] + [f"- `{name}`" for name in produced] + [""]

@@ -15,6 +15,9 @@
 # seed used 1024^2 for groups 1-4 and 18-22 and 2048^2 for groups 23-27, 50 surfaces per group.
 #   group 18        : 512^2, 6 surfaces, the 95-step history (7.11) with Delta_1 = 0.2/30 (SPEC erratum)
 #   group 18 @ 1024 : 4 surfaces on the seed's grid, 33 steps (below): the grid effect on A*
+#   groups 18, 22, 23, 27 @ 2048 : 33 steps, 2 surfaces by default (stages g18_2048 ...; group 18 ran 6
+#                     with G18_2048_SIZE=6): with the BCCG active set one 2048^2 surface along the 33
+#                     steps takes ~250 s of CPU
 #   groups 1, 2     : 512^2, 6 surfaces, the 95-step history
 #   groups 22,23,27 : 512^2, 4 surfaces, 33 of the 95 history steps
 #   groups 19-21, 24-26 : 512^2, 2 surfaces, 33 steps
@@ -62,6 +65,9 @@ stage() {
         g03)      run group03_N1024 03 1024 "${G03_SIZE:-2}" "$EARLY_LATE" ;;
         g04)      run group04_N1024 04 1024 "${G04_SIZE:-2}" "$EARLY_LATE" ;;
         g18_1024) run group18_N1024 18 1024 "${G18_1024_SIZE:-4}" "$SUBSET" ;;
+        g18_2048|g22_2048|g23_2048|g27_2048)
+                  g=${1%_2048}; g=${g#g}; v=G${g}_2048_SIZE
+                  run "group${g}_N2048" "$g" 2048 "${!v:-2}" "$SUBSET" ;;
         extras)   echo "=== $(date +%H:%M:%S) extras" | tee -a "$OUT/logs/runs.log"
                   $PY studies/ensemble_figures.py --extras >>"$OUT/logs/extras.log" 2>&1 ;;
         *) echo "unknown stage $1" >&2; return 2 ;;
@@ -70,7 +76,8 @@ stage() {
 
 STAGES=("$@")
 if [ ${#STAGES[@]} -eq 0 ]; then
-    STAGES=(g18 g18_1024 g01 extras g22 g23 g27 g02 g19 g20 g21 g24 g25 g26 g03 extras)
+    STAGES=(g18 g18_1024 g01 extras g22 g23 g27 g02 g19 g20 g21 g24 g25 g26 g03 g18_2048 g22_2048 g23_2048
+            g27_2048 extras)
 fi
 for s in "${STAGES[@]}"; do
     stage "$s"
