@@ -90,13 +90,14 @@ class PolonskyKeer:
         self.refresh = options.getInt("pk_refresh", self.refresh)
         self.active_set = options.getString("pk_active_set", self.active_set)
         if self.active_set not in ACTIVE_SETS:
-            raise UserError(f"-pk_active_set: unknown strategy '{self.active_set}' (one of {', '.join(ACTIVE_SETS)})")
+            raise UserError(f"-pk_active_set: unknown strategy '{self.active_set}' "
+                            f"(one of {', '.join(ACTIVE_SETS)})")
         if self.refresh < 1:
             raise UserError(f"-pk_refresh must be a positive number of iterations, got {self.refresh}")
 
     def view(self, tao, viewer):
-        viewer.printfASCII(f"  Polonsky-Keer CG, active set {self.active_set}, preconditioner {self.preconditioner}, "
-                           f"K p refreshed every {self.refresh} iterations\n")
+        viewer.printfASCII(f"  Polonsky-Keer CG, active set {self.active_set}, preconditioner "
+                           f"{self.preconditioner}, K p refreshed every {self.refresh} iterations\n")
 
     def destroy(self, tao=None):
         for v in self.vecs:

@@ -656,7 +656,9 @@ def acceptance(ensembles, produced, report):
         fit_dev = np.max(np.abs(grid["A"]["inf"][sel] - M.curvefit_area(grid["p"][sel], grid["alpha_p"], b, c, d)))
         b2, c2, d2 = M.fit_curvefit(grid["p"], grid["A"]["inf"], M.ALPHA_P_TABLE_8_3[18])
         sb, sc, sd = M.TABLE_8_4[18]
-        report.append(f"| 18 extrapolated (2 A_{grid['extrapolation'][0]} - A_{grid['extrapolation'][1]}) | h -> 0 | — | {b:.3f} | {sb:.3f} | {c:.3f} | {sc:.3f} | "
+        fine, coarse = grid["extrapolation"]
+        report.append(f"| 18 extrapolated (2 A_{fine} - A_{coarse}) | h -> 0 | — | {b:.3f} | {sb:.3f} | {c:.3f} | "
+                      f"{sc:.3f} | "
                       f"{d:.4f} | {sd:.3f} | {fit_dev:.4f} | {b2:.3f}, {c2:.3f}, {d2:.4f} |")
     at512 = [f for f in fits if f[0].N == 512]
     if len(at512) > 1:
@@ -783,22 +785,25 @@ def differences(ensembles, report):
                "overestimates the contact ratio on coarse grids (every boundary node with p > 0 counts as a whole "
                "node), most at light load; the perimeter-corrected A* is shown beside it. Group 3 (k_s = 256) ran "
                "at 1024^2 (4 nodes per 1/k_s). Group 4 (k_s = 512) would need k_s <= Nyquist/2, i.e. 2048^2; "
-               "not run unless a group-4 file is listed above. Group 18 also ran on the seed's 1024^2 (4 surfaces) to measure "
-               "the grid effect.",
+               "not run unless a group-4 file is listed above. Group 18 also ran on the seed's 1024^2 (4 surfaces) "
+               "and on 2048^2 (6 surfaces), groups 22, 23 and 27 on 2048^2 (2 surfaces each; the seed's grid for "
+               "23 and 27), to measure the grid effect.",
                "- **Surfaces per group.** The seed: 50 per group. Ours: see the table above.",
                "- **Load steps.** Groups 1-3 and 18 follow the 95-step history (7.11) with Delta_1 = 0.2/30 (SPEC "
                "erratum; the printed 0.067 contradicts n1 = 30 steps over (0, 0.2]). Groups 19-27 used 33 of those "
                "95 steps (every third counted back from p* = 4, plus p* = 2.0028): a step's solution does not "
                "depend on the path (the QP has a unique solution), only the warm start does, so A*(p*) at these "
                "steps is the same as on the full path, at 1/2.7 of the cost. Figs. 8.1-8.3 compare the groups at "
-               "these shared steps. Group 18 on 1024^2 used the same 33 steps; group 3 (1024^2) only the steps its "
+               "these shared steps. The 1024^2 and 2048^2 runs used the same 33 steps; group 3 (1024^2) only the "
+               "steps its "
                "figures need: every second history step of the early stage (15 steps, p* <= 0.2) and of the "
                "nearly-complete stage (10 steps, p* = 2.2 ... 4).",
-               "- **Cost.** The 95-step history with warm starts cost ~11,000 operator applications per 512^2 surface "
-               "(~3,900 PK iterations, ~60 per step in the middle stage) against ~250 (88 iterations) for one cold "
-               "solve at p* = 0.5: about 45 cold solves (SPEC target: <= 10). Under the load of the time (2 shared "
-               "cores, load average ~10) a 512^2 surface took 100-190 s of wall per rank, a 1024^2 one ~600 s along "
-               "33 steps; hence the small ensembles. The surfaces of a group differ little (standard error of the "
+               "- **Cost.** The 512^2 and 1024^2 ensembles ran with PK's restart rule: the 95-step history cost "
+               "~11,000 operator applications per 512^2 surface, and under the load of the time (2 shared cores, "
+               "load average ~10) a 512^2 surface took 100-190 s of wall per rank, a 1024^2 one ~600 s along 33 "
+               "steps. The 2048^2 ensembles ran with the BCCG active set (now the default, ~2.6x fewer "
+               "applications): ~250 s per 2048^2 surface along the 33 steps. Hence the small ensembles. The "
+               "surfaces of a group differ little (standard error of the "
                "mean A* <= 0.002 at every step, last column of the acceptance table), so the means are settled "
                "to well below the 0.02 tolerance; the grid is the larger effect.",
                "- **Convergence criterion.** The seed stopped on its composite criterion (3.47)-(3.49), (3.51); we "

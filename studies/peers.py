@@ -2,7 +2,7 @@
 
     bash studies/peers/install.sh            # once: the peers' own virtualenv .peers-venv
     .venv/bin/python studies/peers.py [--sizes 256 512 1024] [--pstar 0.5] \
-        [--ours pk_pc=none pk_pc=fourier] [--repeats 3]
+        [--ours pk_pc=none,pk_active_set=pk default] [--tolerances 1e-8 1e-9] [--repeats 3]
 
 For each N: the group-1 surface (k_l, k_s, H, m2) = (16, 64, 0.8, 2e-4), seed 1, unit cell, E* = 1, is
 saved as .npy; the load is pbar = p* sqrt(m0^p) (from our ContactProblem). Each of our option sets
@@ -188,8 +188,9 @@ def main():
     parser.add_argument("--sizes", type=int, nargs="+", default=[256, 512, 1024])
     parser.add_argument("--pstar", type=float, default=0.5)
     parser.add_argument("--seed", type=int, default=1)
-    parser.add_argument("--ours", nargs="+", default=["pk_pc=none", "pk_pc=fourier"],
-                        help="our option sets, e.g. pk_pc=none pk_pc=fourier,pk_refresh=50 (default: both PCs)")
+    parser.add_argument("--ours", nargs="+", default=["pk_pc=none,pk_active_set=pk", "default"],
+                        help="our option sets, e.g. pk_pc=none pk_pc=fourier,pk_refresh=50 (default: the published "
+                             "PK and our default solver)")
     parser.add_argument("--peers", nargs="+", default=list(PEERS), choices=PEERS)
     parser.add_argument("--target", type=float, default=1e-8, help="natural KKT residual to reach (default 1e-8)")
     parser.add_argument("--tolerances", type=float, nargs="+",
@@ -210,7 +211,8 @@ def main():
     workdir = tempfile.mkdtemp(prefix="roughpetsc-peers-")
     record = {
         "surface": dict(SURFACE, seed=args.seed, cell=1.0, E_star=1.0), "pstar": args.pstar,
-        "target": args.target, "repeats": args.repeats, "host": platform.node(), "cpus": os.cpu_count(),
+        "target": args.target, "tolerances": args.tolerances, "repeats": args.repeats, "host": platform.node(),
+        "cpus": os.cpu_count(),
         "loadavg_start": os.getloadavg(), "started": time.strftime("%Y-%m-%d %H:%M:%S"), "sizes": [],
     }
     try:
@@ -338,7 +340,8 @@ def write_outputs(record, args):
         "",
         f"Target: natural KKT residual ||min(p/pbar, g/sqrt(m0^h))||_inf <= {record['target']:g}, evaluated by "
         "OUR operator on every solver's pressure field (g = K p + d - h, d from a zero mean gap on the contact "
-        "set). A peer's tolerance is the loosest of the decade scan 1e-4 ... 1e-14 that reaches the target "
+        f"set). A peer's tolerance is the loosest of the scan {' '.join(f'{t:g}' for t in record['tolerances'])} "
+        "that reaches the target "
         "(Tamaas: PKR's own error; ContactMechanics: pentol = tol rms(h), forcetol = tol x mean nodal force, "
         "thermotol = tol). A* by node count, gbar = mean gap over all nodes. Relative differences against "
         f"the first of our rows. Wall time: the solve only, minimum of {record['repeats']} runs; CPU: the "
@@ -365,7 +368,9 @@ def write_outputs(record, args):
         lines += ["", "Versions: " + ", ".join(f"{k} {v}" for k, v in versions.items())
                   + f"; roughpetsc on PETSc {'.'.join(map(str, PETSc.Sys.getVersion()))}."]
     lines += ["", "Regenerate: `bash studies/peers/install.sh && .venv/bin/python studies/peers.py "
-              + " ".join(["--sizes"] + [str(x["n"]) for x in record["sizes"]]) + "`", ""]
+              + " ".join(["--sizes"] + [str(x["n"]) for x in record["sizes"]])
+              + " --tolerances " + " ".join(f"{t:g}" for t in record["tolerances"])
+              + f" --repeats {record['repeats']}`", ""]
     tmp = args.output + ".md.tmp"
     with open(tmp, "w") as f:
         f.write("\n".join(lines))
