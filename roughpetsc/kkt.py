@@ -191,9 +191,13 @@ class CompositeCriterion:
         p = x.getArray(readonly=True)
         g = self.gap_of(x)
         contact = p > 0
+        if self.previous is None:
+            self.previous, change2 = np.array(p), np.inf
+        else:
+            np.subtract(p, self.previous, out=self.previous)  # the change, in the buffer of the previous iterate
+            change2 = np.dot(self.previous, self.previous)
         p_norm2, change2, n_contact, gap_sum, gap2_contact = allsum(self.comm, [
-            np.dot(p, p), np.dot(p - self.previous, p - self.previous) if self.previous is not None else np.inf,
-            np.count_nonzero(contact), g[~contact].sum(), np.dot(g[contact], g[contact])])
+            np.dot(p, p), change2, np.count_nonzero(contact), g[~contact].sum(), np.dot(g[contact], g[contact])])
         area = n_contact / self.n_total
         relative_change = float(np.sqrt(change2 / p_norm2)) if p_norm2 > 0 else np.inf
         area_change = abs(area - self.previous_area) / area if self.previous_area is not None and area else np.inf
@@ -204,5 +208,5 @@ class CompositeCriterion:
         self.rows.append((iteration, relative_change, area_change, sigma, bound, natural))
         if self.first is None and relative_change < 5e-5 and area_change < 2.0 / self.n_total and sigma < bound:
             self.first = iteration
-        self.previous = np.array(p)
+        np.copyto(self.previous, p)
         self.previous_area = area

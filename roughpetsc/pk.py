@@ -128,6 +128,7 @@ class PolonskyKeer:
         bccg = self.active_set == "bccg"
         precondition = self.preconditioner == "fourier"
         contact = np.empty_like(p)  # 1.0 on the contact set, 0.0 elsewhere: masks as dot products
+        negative = np.empty(p.shape, dtype=bool)  # scratch mask, so the loop allocates no N^2 temporaries
         t[...] = 0.0
         if not load_control:
             self.separation = self.target_separation
@@ -167,10 +168,14 @@ class PolonskyKeer:
                 break
             # The free set: the contact set, and under BCCG also the nodes out of contact that overlap.
             if bccg:
-                np.copyto(contact, 1.0, where=gap < 0)
-            count, gap_sum = allsum(mpi, [contact.sum(), np.dot(gap, contact)])
+                np.less(gap, 0.0, out=negative)
+                np.copyto(contact, 1.0, where=negative)
+            if bccg or not load_control:
+                count, gap_sum = allsum(mpi, [contact.sum(), np.dot(gap, contact)])
+            else:
+                gap_sum = 0.0  # the free set is the contact set, where d has made the mean gap zero
             r = response
-            if load_control:
+            if load_control and gap_sum:
                 # Directions keep the load: the residual has zero mean on the free set.
                 np.subtract(gap, gap_sum / count, out=r)
                 r *= contact
@@ -211,13 +216,14 @@ class PolonskyKeer:
             np.multiply(t, step, out=response)
             p -= response
             # Projection onto p >= 0; under PK, nodes out of contact that overlap enter and CG restarts.
-            clipped = np.count_nonzero(p < 0)
+            clipped = np.count_nonzero(np.less(p, 0.0, out=negative))
             np.maximum(p, 0.0, out=p)
             if bccg:
                 changed, = allsum(mpi, [clipped])
                 entering = 0
             else:
-                overlap = (gap < 0) & (p == 0)
+                overlap = np.less(gap, 0.0, out=negative)
+                overlap &= p == 0
                 changed, entering = allsum(mpi, [clipped, np.count_nonzero(overlap)])
                 if entering:
                     np.multiply(gap, -step, out=response)

@@ -251,9 +251,7 @@ def plot(sizes, series):
     axis.set_ylabel("condition number on the contact set")
     axis.grid(alpha=0.3, which="both")
     axis.legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(OUT, "conditioning.png"), dpi=110)
-    plt.close(fig)
+    common.save_figure(fig, OUT, "conditioning.png")
 
 
 if __name__ == "__main__":

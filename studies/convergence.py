@@ -85,11 +85,7 @@ def plot(records, n, pstar):
     axes[2].legend(fontsize=7, ncol=2)
     fig.suptitle(f"Group #1, N = {n}, p* = {pstar}: solid PK (load control), dashed ALMM (load), "
                  "dotted TAO bound types (displacement control at the same solution)")
-    fig.tight_layout()
-    path = os.path.join(OUT, f"convergence_N{n}_p{pstar:g}.png")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return os.path.basename(path)
+    return common.save_figure(fig, OUT, f"convergence_N{n}_p{pstar:g}.png")
 
 
 def growth_exponent(sizes, counts):
@@ -206,7 +202,9 @@ def write_report(args, records, figures, composite_rows):
         *[f"![{f}]({f})" for f in figures],
         "",
         f"Regenerate: `.venv/bin/python studies/convergence.py --sizes {' '.join(map(str, args.sizes))} "
-        f"--pstars {' '.join(f'{p:g}' for p in args.pstars)} --max-time {args.max_time:g}`",
+        f"--pstars {' '.join(f'{p:g}' for p in args.pstars)} --max-time {args.max_time:g} --rtol {args.rtol:g}"
+        + (f" --presets {' '.join(args.presets)}" if args.presets else "")
+        + f" --large-presets {' '.join(args.large_presets)} --huge-presets {' '.join(args.huge_presets)}`",
         "",
     ]
     with open(os.path.join(OUT, "convergence.md"), "w") as f:

@@ -81,7 +81,7 @@ def main():
             f"'ratio a linear rate predicts' sums that over the steps, and 'r0 needed for 10x' is the start "
             f"residual every step would need for the history to cost 10 cold solves.\n\n{table}\n\n"
             f"Regenerate: `.venv/bin/python studies/load_history.py --n {args.n} --presets "
-            f"{' '.join(args.presets)}`\n")
+            f"{' '.join(args.presets)} --repeat {args.repeat}`\n")
     with open(os.path.join(common.OUTPUT, f"load_history_N{args.n}.md"), "w") as f:
         f.write(text)
     print(text)

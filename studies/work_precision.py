@@ -95,11 +95,7 @@ def plot(rows, n, pstar):
     axes[2].legend(fontsize=7, ncol=2)
     fig.suptitle(f"Work-precision, group #1, N = {n}, p* = {pstar:g}: one point per tolerance "
                  "(solid PK, dashed ALMM, dotted TAO bound types at the reference separation)")
-    fig.tight_layout()
-    path = os.path.join(OUT, f"work_precision_p{pstar:g}.png")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return os.path.basename(path)
+    return common.save_figure(fig, OUT, f"work_precision_p{pstar:g}.png")
 
 
 def time_to(rows, name, pstar, key, level):

@@ -74,26 +74,16 @@ def test_displacement_control_matches_blmvm(problem, preconditioner):
     assert result.pstar == pytest.approx(0.5, rel=1e-7)
 
 
-def test_unknown_preconditioner_is_a_user_error(problem):
+@pytest.mark.parametrize("option, value", [("pk_pc", "multigrid"), ("pk_active_set", "greedy")])
+def test_unknown_choice_is_a_user_error_naming_its_option(problem, option, value):
     from roughpetsc.errors import UserError
 
-    PETSc.Options().setValue("pk_pc", "multigrid")
+    PETSc.Options().setValue(option, value)
     try:
-        with pytest.raises(UserError, match="-pk_pc"):
+        with pytest.raises(UserError, match=f"-{option}"):
             Solver(problem, "load", None, 1e-8)
     finally:
-        PETSc.Options().delValue("pk_pc")
-
-
-def test_unknown_active_set_is_a_user_error(problem):
-    from roughpetsc.errors import UserError
-
-    PETSc.Options().setValue("pk_active_set", "greedy")
-    try:
-        with pytest.raises(UserError, match="-pk_active_set"):
-            Solver(problem, "load", None, 1e-8)
-    finally:
-        PETSc.Options().delValue("pk_active_set")
+        PETSc.Options().delValue(option)
 
 
 def test_fourier_preconditioner_is_symmetric_positive_definite_on_a_free_set():
