@@ -40,6 +40,12 @@ class ContactProblem:
     comm : petsc4py.PETSc.Comm
     fft_threads, fft_effort :
         Passed to :class:`~roughpetsc.westergaard.Westergaard`.
+
+    Attributes
+    ----------
+    progress : callable or None
+        Called as ``progress(iteration, natural_residual, seconds)`` with every residual that a
+        solver of this problem records (:class:`~roughpetsc.kkt.History`); None by default.
     """
 
     def __init__(self, grid, heights, E_star, comm=None, fft_threads=1, fft_effort="FFTW_MEASURE"):
@@ -64,6 +70,7 @@ class ContactProblem:
         self.m0p_scaled = sum_pc2 / self.n
         self.complete_contact_pbar = float(-allmin(self.mpi, [local_pc.min()])[0])
         self.max_height = float(-allmin(self.mpi, [-self.local(self.heights, readonly=True).max()])[0])
+        self.progress = None
 
     # --- vectors and fields -------------------------------------------------
     def vec(self):
@@ -158,7 +165,10 @@ def contact_perimeter_edges(problem, in_contact):
 
 
 def _next_rank_first_row(comm, rows):
-    """The first row of the next rank (periodically): the neighbour below this rank's last row."""
+    """The first row of the next rank (periodically): the neighbour below this rank's last row.
+
+    Every rank owns at least one row (:func:`roughpetsc.slab.row_split`), however unevenly they are shared.
+    """
     size, rank = comm.Get_size(), comm.Get_rank()
     if size == 1:
         return rows[0]

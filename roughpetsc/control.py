@@ -14,6 +14,7 @@ updates the pressure Vec it is given (the warm start) and returns an
 :class:`~roughpetsc.contact.Result`.
 """
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 import time
 
@@ -22,7 +23,7 @@ from petsc4py import PETSc
 
 from .contact import Result, measure
 from .errors import UserError
-from .kkt import ConvergenceTest, History, report
+from .kkt import ConvergenceTest, History, allsum, report
 from .pk import PolonskyKeer
 from .preconditioner import FourierPreconditioner
 
@@ -55,10 +56,34 @@ def reason_name(reason):
     return str(reason)
 
 
-def _reason(tao, test):
-    """PETSc's reason, with what our convergence test stopped for (time limit, stagnation)."""
+def _reason(tao, test, restarts=0):
+    """PETSc's reason, with what our convergence test stopped for (time limit, stagnation) and the floor.
+
+    ``test`` is a :class:`~roughpetsc.kkt.ConvergenceTest` or the Polonsky-Keer context (both have
+    ``stopped_by`` and ``best_natural``). A solve that ends short of the tolerance says which natural
+    residual it reached (and, after restarts, that this is the floor that restarting could not
+    lower), so a bare DIVERGED_LS_FAILURE is never the whole story.
+    """
     name = reason_name(tao.getConvergedReason())
-    return f"{name} ({test.stopped_by})" if test.stopped_by and name == "DIVERGED_USER" else name
+    notes = [test.stopped_by] if test.stopped_by and name == "DIVERGED_USER" else []
+    if tao.getConvergedReason() < 0 and np.isfinite(test.best_natural):
+        measure = "natural residual" if getattr(test, "target_pbar", None) is None else "of natural residual, load error"
+        notes.append(f"best {measure} {test.best_natural:.2g}")
+        if restarts:
+            notes.append(f"floor after {restarts} restart{'s' * (restarts > 1)}")
+    return f"{name} ({', '.join(notes)})" if notes else name
+
+
+def restartable(reason, test):
+    """True for the stops that round-off in the objective causes: a failed line search, stagnation."""
+    return reason in (PETSc.TAO.Reason.DIVERGED_LS_FAILURE, PETSc.TAO.Reason.DIVERGED_TR_REDUCTION) \
+        or (reason == PETSc.TAO.Reason.DIVERGED_USER and test.stopped_by == "stagnation")
+
+
+# Restarts of a TAO solve that stopped for round-off (BoundQP.solve): at most this many, and only
+# while each attempt lowers the best natural residual below this fraction of the previous one.
+MAX_RESTARTS = 8
+RESTART_GAIN = 0.9
 
 
 def max_seconds():
@@ -79,10 +104,73 @@ def set_from_options(tao, cleanup):
         raise UserError(f"a solver option was refused by PETSc: {lines[-1]}") from None
 
 
-def _set_default_option(name, value):
+@contextmanager
+def default_options(defaults):
+    """Options that apply inside the block unless the user gave them; removed again afterwards.
+
+    The working defaults of one solver object must not stay in the global options database, where
+    they would become the next object's settings (BNLS's CG made a later BNTR refuse its KSP).
+    """
     options = PETSc.Options()
-    if not options.hasName(name):
-        options.setValue(name, value)
+    inserted = [name for name in defaults if not options.hasName(name)]
+    for name in inserted:
+        options.setValue(name, defaults[name])
+    try:
+        yield
+    finally:
+        for name in inserted:
+            options.delValue(name)
+
+
+class QuadraticObjective:
+    """The QP objective f = p'Kp/2 + p'(d - h) and its gradient, the gap g = K p + d - h, free of cancellation.
+
+    TAO uses f only through differences, so f is measured from the first point evaluated after
+    :meth:`restart` and accumulated from the last evaluated point r: f(x) = f(r) + (x - r)'(g(x) + g(r)) / 2,
+    exact for a quadratic. Evaluated directly, f = (p'g + d sum(p) - p'h) / 2 carries a round-off of
+    about eps |f| while a step near the solution changes f by about (residual)^2 |f|, so below a
+    residual of about 1e-8 every line search and trust-region ratio failed for round-off (TAO's
+    DIVERGED_LS_FAILURE at 1.9e-9 on a 128^2 problem). The increment's round-off is relative to
+    the step, and after a restart the values TAO compares are as small as the decrease left.
+
+    The last point and its gap are cached: :meth:`gap_of` of the last evaluated point costs nothing.
+    """
+
+    def __init__(self, problem):
+        self.problem = problem
+        self.separation = 0.0
+        self.value = 0.0
+        self.point, self.gap, self.step = problem.vec(), problem.vec(), problem.vec()
+        self.cached = False
+
+    def restart(self, separation=None):
+        """Forget the cache (and set a new separation): the next evaluated point has f = 0."""
+        if separation is not None:
+            self.separation = separation
+        self.cached = False
+
+    def evaluate(self, x, out):
+        """``out = g(x)`` (one operator application); returns f(x)."""
+        if self.cached:
+            self.step.waxpy(-1.0, self.point, x)
+            increment = self.step.dot(self.gap)
+        self.problem.gap(x, self.separation, out)
+        self.value = self.value + 0.5 * (increment + self.step.dot(out)) if self.cached else 0.0
+        x.copy(self.point)
+        if out is not self.gap:
+            out.copy(self.gap)
+        self.cached = True
+        return self.value
+
+    def gap_of(self, x):
+        """The gap of ``x`` as this rank's local array, from the cache when ``x`` is the last point."""
+        if not (self.cached and x.equal(self.point)):
+            self.evaluate(x, self.gap)
+        return self.problem.local(self.gap, readonly=True)
+
+    def destroy(self):
+        for v in (self.point, self.gap, self.step):
+            v.destroy()
 
 
 class BoundQP:
@@ -102,11 +190,9 @@ class BoundQP:
         self.problem = problem
         self.rtol = rtol
         self.max_seconds = max_seconds()
-        self.separation = 0.0
         comm = problem.comm
-        self.gap_vec = problem.vec()
-        self.cached_x = problem.vec()
-        self.has_cache = False
+        self.objective = QuadraticObjective(problem)
+        self.best = problem.vec()  # the best iterate of a solve (lowest natural residual)
         self.hessian = problem.operator.mat()
         self.lower = problem.vec()
         self.lower.set(0.0)
@@ -116,9 +202,12 @@ class BoundQP:
         self.fourier = self.preconditioning = None
         tao = self.tao = PETSc.TAO().create(comm)
         tao.setType(tao_type)
+        defaults = {}
         if tao_type in ("tron", "gpcg"):
             # The default mask subset and ILU fail on a shell Hessian.
-            _set_default_option("tao_subset_type", "subvec")
+            defaults["tao_subset_type"] = "subvec"
+        if tao_type == "bnls":  # its default KSP, STCG, took 100x the operator applications of CG here
+            defaults["tao_bnk_ksp_type"] = "cg"
         preconditioner = PETSc.Options().getString("bound_pc",
                                                    "fourier" if tao_type in FOURIER_DEFAULT_TYPES else "none")
         if preconditioner not in BOUND_PRECONDITIONERS:
@@ -138,46 +227,59 @@ class BoundQP:
         tao.setTolerances(gatol=0.0, grtol=0.0, gttol=0.0)
         tao.setMaximumIterations(DEFAULT_MAX_IT)
         tao.setMaximumFunctionEvaluations(10 * DEFAULT_MAX_IT)
-        set_from_options(tao, self.destroy)
+        with default_options(defaults):
+            set_from_options(tao, self.destroy)
         self.tao_type = tao.getType()
 
     def _objective_gradient(self, tao, x, gradient):
-        """f = p'Kp/2 + p'(d - h) = (p'g + d sum(p) - p'h) / 2 with the gradient g = K p + d - h."""
-        self.problem.gap(x, self.separation, gradient)
-        x.copy(self.cached_x)
-        gradient.copy(self.gap_vec)
-        self.has_cache = True
-        return 0.5 * (x.dot(gradient) + self.separation * x.sum() - x.dot(self.problem.heights))
+        return self.objective.evaluate(x, gradient)
 
     def _hessian(self, tao, x, H, P):
-        pass
+        H.getPythonContext().perturbation = 0.0  # a fresh Hessian: BNK's MatShift of the last one is undone
 
-    def gap_of(self, x):
-        """Gap of the iterate ``x`` (local array), reusing the objective's when ``x`` is the last evaluated."""
-        if not (self.has_cache and x.equal(self.cached_x)):
-            self.problem.gap(x, self.separation, self.gap_vec)
-            x.copy(self.cached_x)
-            self.has_cache = True
-        return self.problem.local(self.gap_vec, readonly=True)
+    @property
+    def separation(self):
+        return self.objective.separation
 
     def solve(self, separation, pressure, history=None):
-        """Solve at ``separation`` (scaled) from the start ``pressure`` (overwritten)."""
-        self.separation = separation
-        self.has_cache = False
-        history = history or History(self.problem.operator)
-        test = ConvergenceTest(self.problem.mpi, self.problem.n, self.rtol, self.gap_of, history,
-                               max_seconds=self.max_seconds)
+        """Solve at ``separation`` (scaled) from the start ``pressure`` (overwritten).
+
+        When TAO stops short of the tolerance for a reason that round-off can cause (a failed line
+        search, or no progress for many iterations), it is restarted from its best iterate with the
+        objective measured from there; this repeats while each attempt improves the best residual
+        by at least :data:`RESTART_GAIN`, at most :data:`MAX_RESTARTS` times. If the tolerance is
+        still not met, the best iterate is returned and the reason names the floor reached.
+        """
+        self.objective.restart(separation)
+        history = history or History(self.problem)
+        test = ConvergenceTest(self.problem.mpi, self.problem.n, self.rtol, self.objective.gap_of, history,
+                               max_seconds=self.max_seconds, best=self.best)
         self.tao.setConvergenceTest(test)
         # A start outside the bounds would be projected by TAO anyway; do it here.
         local = self.problem.local(pressure)
         np.maximum(local, 0.0, out=local)
-        self.tao.setSolution(pressure)
-        self.tao.solve(pressure)
-        return Outcome(separation, self.tao.getIterationNumber(), _reason(self.tao, test), history.as_array())
+        iterations, restarts, floor = 0, 0, np.inf
+        while True:
+            self.objective.restart()
+            self.tao.setSolution(pressure)
+            self.tao.solve(pressure)
+            iterations += self.tao.getIterationNumber()
+            test.iteration_offset = iterations
+            reason = self.tao.getConvergedReason()
+            if reason > 0 or not restartable(reason, test) or restarts == MAX_RESTARTS \
+                    or not test.best_natural < RESTART_GAIN * floor:
+                break
+            floor = test.best_natural
+            restarts += 1
+            test.stopped_by, test.since_best = None, 0
+            self.best.copy(pressure)
+        if reason < 0 and np.isfinite(test.best_natural):
+            self.best.copy(pressure)
+        return Outcome(separation, iterations, _reason(self.tao, test, restarts), history.as_array())
 
     def destroy(self):
         self.tao.destroy()
-        for obj in (self.gap_vec, self.cached_x, self.hessian, self.lower, self.upper, self.gradient,
+        for obj in (self.objective, self.best, self.hessian, self.lower, self.upper, self.gradient,
                     self.preconditioning, self.fourier):
             if obj is not None:
                 obj.destroy()
@@ -204,9 +306,8 @@ class RootFind:
         from scipy.optimize import brentq
 
         problem = self.problem
-        history = History(problem.operator)
-        state = {"iterations": 0, "evaluations": 0, "reason": "DIVERGED_MAXFCN"}
-        time_limit = self.qp.max_seconds
+        history = History(problem)
+        state = {"iterations": 0, "evaluations": 0, "inner": "", "stop": None, "separation": None}
 
         class Found(Exception):
             pass
@@ -219,15 +320,15 @@ class RootFind:
             outcome = self.qp.solve(d, pressure, history)
             state["iterations"] += outcome.iterations
             state["evaluations"] += 1
-            state["reason"] = outcome.reason
+            state["inner"], state["separation"] = outcome.reason, d
             mean_p = pressure.sum() / problem.n
             if abs(mean_p - pbar) <= self.rtol * pbar:
-                state["separation"] = d
                 raise Found
             if state["evaluations"] >= self.max_evaluations:
+                state["stop"] = "DIVERGED_ROOT_MAXFCN"
                 raise Found
-            if history.out_of_time(time_limit):
-                state["reason"] = "DIVERGED_USER (time limit)"
+            if history.out_of_time(self.qp.max_seconds):
+                state["stop"] = "DIVERGED_USER"
                 raise Found
             return mean_p - pbar
 
@@ -236,19 +337,23 @@ class RootFind:
             if separation_guess is not None and 0.0 < separation_guess < upper:
                 value = excess(separation_guess)
                 lower, upper = (separation_guess, upper) if value > 0 else (lower, separation_guess)
-            d = brentq(excess, lower, upper, xtol=1e-15 * problem.max_height, rtol=1e-15,
-                       maxiter=self.max_evaluations)
-            state["separation"] = d
-            state["reason"] = "DIVERGED_ROOT_TOLERANCE"
+            brentq(excess, lower, upper, xtol=1e-15 * problem.max_height, rtol=1e-15, maxiter=self.max_evaluations)
+            state["stop"] = "DIVERGED_ROOT_TOLERANCE"  # the bracket shrank to round-off without meeting the load
         except Found:
             pass
-        if "separation" not in state:
+        if state["separation"] is None:
             state["separation"] = self.qp.separation
-        reason = state["reason"]
-        if state["evaluations"] >= self.max_evaluations and abs(pressure.sum() / problem.n - pbar) > self.rtol * pbar:
-            reason = "DIVERGED_ROOT_MAXFCN"
-        return Outcome(state["separation"], state["iterations"], f"{reason} ({state['evaluations']} inner solves)",
-                       history.as_array())
+        load_error = abs(pressure.sum() / problem.n - pbar) / pbar
+        if state["stop"] is None:
+            reason = f"CONVERGED_ROOT ({state['evaluations']} inner solves)"
+        else:
+            notes = [f"{state['evaluations']} inner solves", f"load error {load_error:.2g}"]
+            if state["stop"] == "DIVERGED_USER":
+                notes.insert(0, "time limit")
+            if not state["inner"].startswith("CONVERGED"):
+                notes.append(f"last inner solve: {state['inner']}")
+            reason = f"{state['stop']} ({', '.join(notes)})"
+        return Outcome(state["separation"], state["iterations"], reason, history.as_array())
 
     def destroy(self):
         self.qp.destroy()
@@ -273,6 +378,7 @@ class ALMMLoad:
         rows = 1 if comm.getRank() == 0 else 0
         self.gradient = problem.vec()
         self.gap_vec = problem.vec()
+        self.objective = QuadraticObjective(problem)  # at separation 0: f = p'Kp/2 - p'h
         self.hessian = problem.operator.mat()
         self.lower = problem.vec()
         self.lower.set(0.0)
@@ -299,10 +405,7 @@ class ALMMLoad:
         self.tao_type = "almm"
 
     def _objective_gradient(self, tao, x, gradient):
-        problem = self.problem
-        problem.gap(x, 0.0, gradient)
-        heights_dot = x.dot(problem.heights)
-        objective = 0.5 * (gradient.dot(x) - heights_dot)
+        objective = self.objective.evaluate(x, gradient)
         if self.history is not None and self.history.out_of_time(self.max_seconds):
             # petsc4py cannot reach the subsolver's convergence test: a zero gradient ends the inner
             # solve at once, and the outer test then reports the time limit.
@@ -313,21 +416,23 @@ class ALMMLoad:
         c.set(x.sum() / self.problem.n - self.target)
 
     def gap_of(self, x):
+        """The gap of ``x`` at the separation that zeroes its mean on the contact set (PK's choice)."""
         problem = self.problem
-        problem.operator.displacement(x, self.gap_vec)
-        displacement = problem.local(self.gap_vec)
-        d = problem.contact_separation(x, displacement)
-        displacement -= problem.local(problem.heights, readonly=True)
-        displacement += d
-        self.separation = d
-        return displacement
+        gap = problem.local(self.gap_vec)
+        np.copyto(gap, self.objective.gap_of(x))  # K p - h
+        in_contact = problem.local(x, readonly=True) > 0
+        gap_sum, count = allsum(problem.mpi, [gap[in_contact].sum(), np.count_nonzero(in_contact)])
+        self.separation = -gap_sum / count if count else problem.max_height
+        gap += self.separation
+        return gap
 
     def solve(self, pbar, pressure):
         self.target = pbar
-        history = self.history = History(self.problem.operator)
+        history = self.history = History(self.problem)
         test = ConvergenceTest(self.problem.mpi, self.problem.n, self.rtol, self.gap_of, history, target_pbar=pbar,
                                max_seconds=self.max_seconds)
         self.tao.setConvergenceTest(test)
+        self.objective.restart()
         self.tao.setSolution(pressure)
         self.tao.solve(pressure)
         self.gap_of(pressure)
@@ -335,7 +440,8 @@ class ALMMLoad:
 
     def destroy(self):
         self.tao.destroy()
-        for obj in (self.gradient, self.gap_vec, self.hessian, self.lower, self.upper, self.constraint, self.jacobian):
+        for obj in (self.gradient, self.gap_vec, self.objective, self.hessian, self.lower, self.upper, self.constraint,
+                    self.jacobian):
             obj.destroy()
 
 
@@ -373,8 +479,7 @@ class PKSolve:
         self.tao.setSolution(pressure)
         self.tao.solve(pressure)
         ctx = self.context
-        return Outcome(ctx.separation, self.tao.getIterationNumber(), reason_name(self.tao.getConvergedReason()),
-                       ctx.history.as_array())
+        return Outcome(ctx.separation, self.tao.getIterationNumber(), _reason(self.tao, ctx), ctx.history.as_array())
 
     def destroy(self):
         self.tao.destroy()
@@ -432,6 +537,7 @@ class Solver:
         problem = self.problem
         start = time.perf_counter()
         applications = problem.operator.applications
+        unconfirmed = False  # PK stopped without confirming on a fresh gap (load control, see _pk_solve)
         if gbar is not None:
             if not gbar > 0:
                 raise UserError(f"-gbar must be positive (complete contact has zero mean gap), got {gbar}")
@@ -444,24 +550,85 @@ class Solver:
             if target >= problem.complete_contact_pbar:
                 outcome = self._complete_contact(target)
             else:
-                self._load_start(target)
+                start_displacement = self._load_start(target)
                 if isinstance(self.backend, RootFind):
                     outcome = self.backend.solve(target, self.pressure, self.last_separation)
+                elif isinstance(self.backend, PKSolve):
+                    outcome = self._pk_solve(target, start_displacement)
+                    unconfirmed = self.backend.context.unconfirmed
                 else:
                     outcome = self.backend.solve(target, self.pressure)
         self.last_separation = outcome.separation
         self.solved_targets = (self.solved_targets + [target])[-2:] if target is not None else []
-        return self._result(outcome, target, start, applications)
+        result = self._result(outcome, target, start, applications)
+        if unconfirmed and not result.converged:
+            # PK stopped on its updated gap and the fresh one disagrees: resume, confirming this time.
+            resumed = self.backend.solve(target, self.pressure)
+            outcome = Outcome(resumed.separation, outcome.iterations + resumed.iterations, resumed.reason,
+                              np.concatenate([outcome.history, resumed.history]))
+            self.last_separation = outcome.separation
+            result = self._result(outcome, target, start, applications)
+        self._keep_displacement(target, outcome.separation)
+        return result
+
+    def _pk_solve(self, target, start_displacement):
+        """PK under load control: it starts from the predicted K p and stops unconfirmed; certified here.
+
+        The predictor knows K p of its start (a combination of the K p of the previous solutions: one FFT
+        pair saved), and PK may stop on its updated gap without a fresh confirming K p (another), because
+        :meth:`_result` checks every result on a fresh gap: if that check fails, :meth:`solve` resumes PK
+        from its iterate with the confirmation on.
+        """
+        context = self.backend.context
+        context.initial_displacement = start_displacement
+        context.confirm = False
+        try:
+            outcome = self.backend.solve(target, self.pressure)
+        finally:
+            context.initial_displacement, context.confirm = None, True
+        return outcome
+
+    def _keep_displacement(self, target, separation):
+        """Keep K p of the solution just certified (from its fresh gap: K p = g - d + h) for the predictor.
+
+        Load control by PK only; the kept K p follow ``solved_targets``.
+        """
+        if not hasattr(self, "_displacement_pool"):
+            self._displacement_pool, self._displacements = [], []  # every Vec made (destroy), the kept ones
+        if target is None or self.control != "load" or not isinstance(self.backend, PKSolve):
+            self._displacements = []
+            return
+        if len(self._displacements) == 2:
+            kept = self._displacements.pop(0)
+        else:
+            kept = self.problem.vec()
+            self._displacement_pool.append(kept)
+        kept.waxpy(1.0, self.problem.heights, self.gap)
+        kept.shift(-separation)
+        self._displacements.append(kept)
 
     def _load_start(self, target):
-        """The start of a load-controlled solve from the previous solutions.
+        """The start of a load-controlled solve from the previous solutions, and its K p if known.
 
         After two load-controlled solves, the pressure is extrapolated
         linearly in the load from them (the predictor of a continuation along
         the load path, its step ratio capped at 2), projected onto p >= 0; it
         is then scaled to the new mean pressure. After one, that solution is
         scaled; with none, the start is uniform.
+
+        Returns K p of the start when it follows from the kept K p of the previous solutions (PK only:
+        the same combination, exact when the projection changed nothing; K of a uniform pressure is 0),
+        else None. Other choices tried along the 95-step history (quadratic or cubic extrapolation in the
+        load, linear or quadratic in log or sqrt of the load, the predicted gap's entering nodes) started
+        no closer: see studies/load_history.py.
         """
+        if not hasattr(self, "_displacement_pool"):
+            self._displacement_pool, self._displacements = [], []  # every Vec made (destroy), the kept K p
+        displacements = self._displacements
+        known = isinstance(self.backend, PKSolve) and len(displacements) == len(self.solved_targets)
+        if known and not hasattr(self, "_start_displacement"):
+            self._start_displacement = self.problem.vec()
+            self._displacement_pool.append(self._start_displacement)
         if self.solved_targets and self.previous is None:
             self.previous = self.problem.vec()
         if len(self.solved_targets) == 2:
@@ -473,14 +640,31 @@ class Solver:
                 self.previous.axpby(1.0 + ratio, -ratio, self.pressure)
                 self.pressure, self.previous = self.previous, self.pressure
                 local = self.problem.local(self.pressure)
+                clipped, = allsum(self.problem.mpi, [np.count_nonzero(local < 0.0)])
                 np.maximum(local, 0.0, out=local)
+                if known:
+                    known = clipped == 0
+                    displacements[1].copy(self._start_displacement)
+                    self._start_displacement.scale(1.0 + ratio)
+                    self._start_displacement.axpy(-ratio, displacements[0])
+            elif known:
+                displacements[1].copy(self._start_displacement)
         elif self.solved_targets:
             self.pressure.copy(self.previous)
+            if known:
+                displacements[0].copy(self._start_displacement)
+        elif known:
+            self._start_displacement.set(0.0)
         mean_p = self.pressure.sum() / self.problem.n
         if mean_p > 0:
             self.pressure.scale(target / mean_p)
+            if known:
+                self._start_displacement.scale(target / mean_p)
         else:
             self.pressure.set(target)
+            if known:
+                self._start_displacement.set(0.0)
+        return self._start_displacement if known else None
 
     def _complete_contact(self, target):
         """Beyond complete contact the exact answer is p = pbar + p_c, g = 0 (d = 0)."""
@@ -518,4 +702,6 @@ class Solver:
         self.pressure.destroy()
         if self.previous is not None:
             self.previous.destroy()
+        for v in getattr(self, "_displacement_pool", []):
+            v.destroy()
         self.gap.destroy()

@@ -50,6 +50,7 @@ HDF5 layout (``n`` finished surfaces in index order, ``m`` load steps)::
         differences on the steps): kappa/bem_A, kappa/bem_A_corrected, kappa/early_<model>, ...
 """
 
+from io import BytesIO
 import json
 import math
 import os
@@ -127,6 +128,7 @@ def parse_models(text):
 def read_settings(reader, size):
     """Read and check every option of the mode (same on all ranks); raise :class:`UserError` naming it."""
     from . import io, loads, surfaces
+    from .slab import row_split
 
     s = {"size": reader.int("ensemble_size", 50), "seed": reader.int("ensemble_seed", 1),
          "group_ranks": reader.int("ensemble_group_ranks", 1),
@@ -166,9 +168,7 @@ def read_settings(reader, size):
                "kl": reader.real("surface_kl", 16.0), "ks": reader.real("surface_ks", 64.0),
                "H": reader.real("surface_H", 0.8), "m2": reader.real("surface_m2", 2e-4)}
     surfaces.check_fractal_parameters(grid, surface["kl"], surface["ks"], surface["H"], surface["m2"])
-    if grid.n0 % s["group_ranks"]:
-        raise UserError(f"-ensemble_group_ranks {s['group_ranks']}: the {grid.n0} grid rows cannot be shared "
-                        f"evenly by the ranks of a group")
+    row_split(grid.n0, s["group_ranks"])  # every rank of a group needs at least one row
     s["grid"], s["surface"] = grid, surface
     return s
 
@@ -266,6 +266,23 @@ class WorkCounter:
             self.comm.send(None, dest=0, tag=TAG_NEXT)
             k = self.comm.recv(source=0, tag=TAG_ITEM)
         return k if k < len(self.items) else -1
+
+    def exhaust(self):
+        """Rank 0: no more items for anybody (the run stops after the surfaces under way).
+
+        Returns how many items had been handed out.
+        """
+        from mpi4py import MPI
+
+        handed = self.next_local
+        if self.window is not None:
+            end, old = np.array([len(self.items)], np.int64), np.zeros(1, np.int64)
+            self.window.Lock(0, MPI.LOCK_EXCLUSIVE)
+            self.window.Fetch_and_op([end, MPI.INT64_T], [old, MPI.INT64_T], 0, 0, MPI.REPLACE)
+            self.window.Unlock(0)
+            handed = int(old[0])
+        self.next_local = max(self.next_local, len(self.items))
+        return min(handed, len(self.items))
 
     def answer(self, source):
         """Rank 0, message mode: give ``source`` its next item."""
@@ -431,11 +448,14 @@ def write_file(path, attrs, pstar_target, records, models=None):
     """Write the whole ensemble file to a hidden temporary beside ``path``, fsync it, rename it over ``path``."""
     import h5py
 
-    folder, name = os.path.split(os.path.abspath(path))
-    temporary = os.path.join(folder, f".{name}.partial")
+    from . import io
+
     records = sorted(records, key=lambda r: r["surface"]["index"])
     n, m = len(records), len(pstar_target)
-    with h5py.File(temporary, "w") as f:
+    # Built in memory, then written as bytes: a full disk is then a plain OSError of the write (HDF5
+    # writing to a full disk leaves objects whose clean-up prints tracebacks of its own).
+    image = BytesIO()
+    with h5py.File(image, "w") as f:
         for key, value in attrs.items():
             f.attrs[key] = value
         f.attrs["n_finished"] = n
@@ -470,15 +490,8 @@ def write_file(path, attrs, pstar_target, records, models=None):
                     group.create_dataset(f"persson/{key}", data=value)
             for key, value in models["kappa"].items():
                 group.create_dataset(f"kappa/{key}", data=value)
-    with open(temporary, "rb+") as handle:
-        os.fsync(handle.fileno())
-    os.replace(temporary, path)
-    try:
-        directory = os.open(folder, os.O_RDONLY)
-        os.fsync(directory)
-        os.close(directory)
-    except OSError:
-        pass
+    with io.atomic_path(path, durable=True) as temporary, open(temporary, "wb") as f:
+        f.write(image.getbuffer())
 
 
 def read_records(path, config):
@@ -612,6 +625,7 @@ class Ensemble:
             try:
                 if os.path.exists(s["output"]):
                     self.records, self.runs, self.wisdom = read_records(s["output"], config)
+                    io.remove_stale_temporaries(s["output"])
                     beyond = [r["surface"]["index"] for r in self.records if r["surface"]["index"] >= s["size"]]
                     if beyond:
                         raise UserError(f"-ensemble_size {s['size']}: the file {s['output']} already holds "
@@ -633,6 +647,8 @@ class Ensemble:
         self.counter = WorkCounter(self.comm, self.todo, use_window=os.environ.get(
             "ROUGHPETSC_ENSEMBLE_COUNTER", "window") != "messages")
         self.received = 0              # records of this run that reached rank 0
+        self.write_error = None        # rank 0: why the file could not be written (then the run winds down)
+        self.expected = len(self.todo)  # rank 0: records to wait for (fewer once the run winds down)
         self.sends = []
         if self.rank == 0:
             provenance = io.provenance()
@@ -652,7 +668,7 @@ class Ensemble:
                 "command": provenance["command"],
                 "options": json.dumps(provenance["options"], sort_keys=True),
                 "versions": json.dumps(provenance["versions"], sort_keys=True)}
-            self.write()
+        io.on_root(self.comm, self.write)  # a file rank 0 cannot write stops every rank, not rank 0 alone
 
     # --- rank 0: file and progress -------------------------------------------
     def say(self, text):
@@ -669,7 +685,12 @@ class Ensemble:
         self.records.append(record)
         self.runs[-1]["solved"].append(surface["index"])
         self.received += 1
-        self.write()
+        if self.write_error is None:
+            try:
+                self.write()
+            except UserError as error:  # disk full, say: stop handing out work; the file keeps what it had
+                self.write_error = str(error)
+                self.expected = self.counter.exhaust()
         elapsed = time.perf_counter() - self.started
         left = len(self.todo) - self.received
         eta = _duration(elapsed / self.received * left) if left else "0s"
@@ -697,7 +718,7 @@ class Ensemble:
 
     def _others_pending(self):
         messages = self.counter.mode == "messages" and self.counter.leaders_done < self.groups - 1
-        return self.received < len(self.todo) or messages
+        return self.received < self.expected or messages
 
     # --- every rank ------------------------------------------------------------
     def work(self):
@@ -736,7 +757,11 @@ class Ensemble:
     def finish(self):
         """Rank 0: the final file with statistics and models; returns the exit status on every rank."""
         status = 0
-        if self.rank == 0:
+        if self.rank == 0 and self.write_error is not None:
+            print(f"roughpetsc: error: {self.write_error}; {self.s['output']} keeps the surfaces it had, and a "
+                  "rerun resumes from them", file=sys.stderr, flush=True)
+            status = 2
+        elif self.rank == 0:
             m = len(self.s["loads"])
             self.records.sort(key=lambda r: r["surface"]["index"])
             models = None

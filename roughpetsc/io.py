@@ -6,6 +6,7 @@ at the end, so a failed or killed run leaves no half-written file.
 
 import json
 import os
+import re
 import sys
 import tempfile
 
@@ -48,21 +49,120 @@ def provenance():
 
 
 def check_writable(path, option):
-    """Fail early, naming the option, if ``path`` cannot be created."""
+    """Fail early, naming the option, if a file cannot be written at ``path``.
+
+    Refused: a folder, a folder that does not exist or takes no new file (tried
+    by creating one, which also catches read-only file systems and root), an
+    existing file without write permission.
+    """
+    if os.path.isdir(path):
+        raise UserError(f"-{option} {path}: is a folder; give a file name")
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
-        raise UserError(f"-{option}: the folder of {path} does not exist")
-    if not os.access(folder, os.W_OK):
-        raise UserError(f"-{option}: cannot write into the folder of {path}")
+        raise UserError(f"-{option} {path}: the folder {folder} does not exist")
+    if os.path.exists(path) and not os.access(path, os.W_OK):
+        raise UserError(f"-{option} {path}: the file is not writable")
+    try:
+        handle, trial = tempfile.mkstemp(prefix=".tmp-", dir=folder)
+    except OSError as error:
+        raise UserError(f"-{option} {path}: cannot create a file in {folder} ({error.strerror})") from None
+    os.close(handle)
+    os.remove(trial)
+
+
+def _same_file(a, b):
+    if os.path.exists(a) and os.path.exists(b):
+        return os.path.samefile(a, b)
+    return os.path.realpath(a) == os.path.realpath(b)
+
+
+def check_outputs(outputs, overwrite=False, inputs=(), may_exist=()):
+    """Refuse, before any work, outputs that would lose a file or cannot be written.
+
+    Parameters
+    ----------
+    outputs : list of (option, path)
+        The files a run will write; empty paths are skipped.
+    overwrite : bool
+        ``-overwrite``: an existing output file may be replaced.
+    inputs : list of (option, path)
+        Files the run reads: never an output, even with ``-overwrite``.
+    may_exist : iterable of option names
+        Outputs that are meant to exist already (a file to resume).
+
+    Raises :class:`UserError` naming the option and the file.
+    """
+    written = []
+    for option, path in outputs:
+        if not path:
+            continue
+        check_writable(path, option)
+        for input_option, input_path in inputs:
+            if input_path and _same_file(path, input_path):
+                raise UserError(f"-{option} {path}: is the input file of -{input_option}; write elsewhere")
+        for other_option, other_path in written:
+            if _same_file(path, other_path):
+                raise UserError(f"-{option} and -{other_option} name the same file {path}")
+        written.append((option, path))
+        if os.path.exists(path) and not overwrite and option not in may_exist:
+            raise UserError(f"-{option} {path}: the file exists; give -overwrite to replace it")
+
+
+def check_figure_format(path, option):
+    """Raise :class:`UserError` naming ``option`` unless matplotlib writes the format of ``path``'s suffix."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    suffix = os.path.splitext(path)[1].lower().lstrip(".")
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if suffix not in formats:
+        raise UserError(f"-{option} {path}: unknown figure format '{suffix}' (one of {', '.join(sorted(formats))})")
+
+
+def on_root(comm, action, *args):
+    """Run ``action(*args)`` on rank 0 only; its :class:`UserError` is raised on every rank.
+
+    What only rank 0 does (checking or writing files) must not fail there
+    alone: the other ranks would wait for ever in their next collective call.
+    The error message is broadcast, so every rank raises the same error (and
+    all ranks leave together). Returns the result on rank 0, None elsewhere.
+    """
+    result, message = None, None
+    if comm is None or comm.Get_rank() == 0:
+        try:
+            result = action(*args)
+        except UserError as error:
+            message = str(error)
+    if comm is not None and comm.Get_size() > 1:
+        message = comm.bcast(message, root=0)
+    if message is not None:
+        raise UserError(message)
+    return result
+
+
+def file_mode():
+    """The mode of a newly created file, ``0o666`` less the umask (0644 under the usual umask 022)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
 
 
 class atomic_path:
-    """Context manager giving a temporary path (same folder, same suffix) that replaces ``path`` on success only."""
+    """Context manager giving a temporary path (same folder, same suffix) that replaces ``path`` on success only.
 
-    def __init__(self, path):
+    The file gets the mode of any new file (:func:`file_mode`; mkstemp's would
+    be 0600). ``durable``: fsync the file and its folder, so that a crash right
+    after leaves the old or the new file, whole. A failure to write raises
+    :class:`UserError` naming ``path``.
+    """
+
+    def __init__(self, path, durable=False):
         self.path = path
+        self.durable = durable
         folder = os.path.dirname(os.path.abspath(path))
-        handle, self.temporary = tempfile.mkstemp(prefix=".tmp-", suffix=os.path.basename(path), dir=folder)
+        try:
+            handle, self.temporary = tempfile.mkstemp(prefix=".tmp-", suffix=os.path.basename(path), dir=folder)
+        except OSError as error:
+            raise UserError(f"cannot write {path}: {_os_reason(error)}") from None
         os.close(handle)
 
     def __enter__(self):
@@ -70,10 +170,54 @@ class atomic_path:
 
     def __exit__(self, kind, value, traceback):
         if kind is None:
-            os.replace(self.temporary, self.path)
-        elif os.path.exists(self.temporary):
+            try:
+                os.chmod(self.temporary, file_mode())
+                if self.durable:
+                    _fsync(self.temporary)
+                os.replace(self.temporary, self.path)
+                if self.durable:
+                    _fsync(os.path.dirname(os.path.abspath(self.path)))
+                return False
+            except OSError as error:
+                kind, value = type(error), error
+        if os.path.exists(self.temporary):
             os.remove(self.temporary)
+        if issubclass(kind, OSError):  # disk full, permissions changed under the run, ...
+            raise UserError(f"cannot write {self.path}: {_os_reason(value)}") from None
         return False
+
+
+def _os_reason(error):
+    """The system's words for an OSError, also when HDF5 wrapped them in its own long message."""
+    found = re.search(r"error message = '([^']+)'", str(error))
+    if found:
+        return found.group(1)
+    return error.strerror or str(error).splitlines()[0]
+
+
+def remove_stale_temporaries(path):
+    """Delete the temporaries of :class:`atomic_path` for ``path`` that a killed run left behind.
+
+    Call only where no other run may be writing ``path`` (a resumed ensemble or load path).
+    """
+    folder = os.path.dirname(os.path.abspath(path))
+    suffix = os.path.basename(path)
+    for name in os.listdir(folder):
+        if name.startswith(".tmp-") and name.endswith(suffix) and len(name) > len(".tmp-") + len(suffix):
+            try:
+                os.remove(os.path.join(folder, name))
+            except OSError:
+                pass
+
+
+def _fsync(path):
+    handle = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(handle)
+    except OSError:  # some file systems cannot fsync a folder
+        pass
+    finally:
+        os.close(handle)
 
 
 def _jsonable(value):
@@ -102,12 +246,16 @@ def _attribute(value):
     return "" if value is None else value
 
 
-def write_h5(path, summary, fields=None, histories=None):
+def write_h5(path, summary, fields=None, histories=None, step_fields=None, attributes=None):
     """Write an HDF5 file: attributes from the summary (nested values as JSON), datasets of fields.
 
     ``fields`` maps names to whole arrays (e.g. heights, pressure, gap),
-    ``histories`` maps step names to residual-history arrays.
+    ``histories`` maps step indices to residual-history arrays,
+    ``step_fields`` maps step indices to ``{name: array}`` kept in ``steps/NNN/``,
+    ``attributes`` maps dataset names to attributes (units, description) given
+    to every dataset of that name.
     """
+    attributes = attributes or {}
     import h5py
 
     with atomic_path(path) as temporary:
@@ -123,5 +271,10 @@ def write_h5(path, summary, fields=None, histories=None):
                 if histories and index in histories:
                     dataset = group.create_dataset("history", data=histories[index])
                     dataset.attrs["columns"] = "iteration, natural_residual, operator_applications, seconds"
+                    dataset.attrs.update(attributes.get("history", {}))
+                for name, array in (step_fields or {}).get(index, {}).items():
+                    dataset = group.create_dataset(name, data=array, compression="gzip", compression_opts=1)
+                    dataset.attrs.update(attributes.get(name, {}))
             for name, array in (fields or {}).items():
-                f.create_dataset(name, data=array, compression="gzip", compression_opts=1)
+                dataset = f.create_dataset(name, data=array, compression="gzip", compression_opts=1)
+                dataset.attrs.update(attributes.get(name, {}))

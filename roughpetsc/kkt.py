@@ -60,6 +60,7 @@ def allmax(comm, values):
     return _allreduce(comm, values, "MAX")
 
 
+@PETSc.Log.EventDecorator("RPKKTCheck")  # -log_view: the residual check of every iteration
 def report(comm, pressure, gap, n_total, target_pbar=None):
     """KKT report of local arrays ``pressure``, ``gap`` (scaled units, rms height 1).
 
@@ -81,16 +82,35 @@ def report(comm, pressure, gap, n_total, target_pbar=None):
     )
 
 
-class History:
-    """Residual history of one solve: iteration, natural residual, operator applications, seconds."""
+def merit(kkt):
+    """One number for "how far from the solution": the natural residual, and the load error if there is one.
 
-    def __init__(self, operator):
-        self.operator = operator
+    A load-controlled iterate with a small natural residual but the wrong mean pressure is not
+    close to the solution (ALMM's early iterates), so the best iterate of a solve and the floor it
+    reports are judged by both.
+    """
+    return kkt.natural if kkt.load_error is None else max(kkt.natural, kkt.load_error)
+
+
+class History:
+    """Residual history of one solve of ``problem``: iteration, natural residual, operator applications, seconds.
+
+    The problem's ``progress`` callable, if set, is called as ``progress(iteration, natural, seconds)``
+    with every row that any solver records (the command line's progress line on a terminal,
+    :class:`Progress`).
+    """
+
+    def __init__(self, problem):
+        self.operator = problem.operator
+        self.progress = problem.progress
         self.start = time.perf_counter()
         self.rows = []
 
     def record(self, iteration, natural):
-        self.rows.append((iteration, natural, self.operator.applications, time.perf_counter() - self.start))
+        seconds = time.perf_counter() - self.start
+        self.rows.append((iteration, natural, self.operator.applications, seconds))
+        if self.progress is not None:
+            self.progress(iteration, natural, seconds)
 
     def out_of_time(self, max_seconds):
         """True when ``max_seconds`` (> 0) have passed since the history started (``-solve_max_time``)."""
@@ -98,6 +118,25 @@ class History:
 
     def as_array(self):
         return np.array(self.rows, dtype=np.float64).reshape(-1, 4)
+
+
+class Progress:
+    """Prints ``iteration, natural residual, elapsed seconds`` of a running solve at most every ``interval`` s.
+
+    Nothing is printed for a solve shorter than ``interval`` (the steps of a load path print their own lines).
+    """
+
+    def __init__(self, interval, stream):
+        self.interval = interval
+        self.stream = stream
+        self.printed_at = -np.inf
+
+    def __call__(self, iteration, natural, seconds):
+        now = time.perf_counter()
+        if seconds >= self.interval and now - self.printed_at >= self.interval:
+            self.printed_at = now
+            print(f"  ... iteration {iteration}, KKT natural {natural:.2e}, {seconds:.1f} s", file=self.stream,
+                  flush=True)
 
 
 # A TAO solve whose natural residual has not improved on its best for this many
@@ -122,7 +161,8 @@ class ConvergenceTest:
     the objective when possible), ``pbar_of(x)`` the normalising pressure.
     """
 
-    def __init__(self, comm, n_total, rtol, gap_of, history, target_pbar=None, pressure_of=None, max_seconds=0.0):
+    def __init__(self, comm, n_total, rtol, gap_of, history, target_pbar=None, pressure_of=None, max_seconds=0.0,
+                 best=None):
         self.comm = comm
         self.n_total = n_total
         self.rtol = rtol
@@ -132,8 +172,10 @@ class ConvergenceTest:
         self.pressure_of = pressure_of or (lambda x: x.getArray(readonly=True))
         self.max_seconds = max_seconds
         self.last = None
-        self.best = np.inf
+        self.best_natural = np.inf
+        self.best = best  # a Vec that receives the best iterate, or None
         self.since_best = 0
+        self.iteration_offset = 0  # iterations of earlier TAO solves of the same problem (restarts)
         self.stopped_by = None  # "time limit" or "stagnation" when this test ended the solve
 
     def __call__(self, tao):
@@ -141,15 +183,18 @@ class ConvergenceTest:
         kkt = report(self.comm, self.pressure_of(x), self.gap_of(x), self.n_total, self.target_pbar)
         self.last = kkt
         iteration = tao.getIterationNumber()
-        self.history.record(iteration, kkt.natural)
+        self.history.record(iteration + self.iteration_offset, kkt.natural)
         load_ok = kkt.load_error is None or kkt.load_error <= self.rtol
         if kkt.natural <= self.rtol and load_ok:
+            self.best_natural = kkt.natural
             return PETSc.TAO.Reason.CONVERGED_USER
         if self.history.out_of_time(self.max_seconds):
             self.stopped_by = "time limit"
             return PETSc.TAO.Reason.DIVERGED_USER
-        if kkt.natural < self.best:
-            self.best, self.since_best = kkt.natural, 0
+        if merit(kkt) < self.best_natural:
+            self.best_natural, self.since_best = merit(kkt), 0
+            if self.best is not None:
+                x.copy(self.best)
         else:
             self.since_best += 1
         if self.since_best >= STAGNATION_ITERATIONS:

@@ -41,12 +41,11 @@ import numpy as np
 from petsc4py import PETSc
 
 from .errors import UserError
-from .kkt import History, allsum, report
+from .kkt import STAGNATION_ITERATIONS, History, allsum, report
 from .preconditioner import FourierPreconditioner
 
 PRECONDITIONERS = ("none", "fourier")
 ACTIVE_SETS = ("pk", "bccg")
-
 
 
 class PolonskyKeer:
@@ -73,6 +72,14 @@ class PolonskyKeer:
         self.active_set = "bccg"
         self.max_seconds = 0.0
         self.history = None
+        # K p of the start, if the caller knows it (then the first fresh K p is skipped); cleared by solve.
+        self.initial_displacement = None
+        # False: a residual below rtol on the updated (not fresh) gap ends the solve, unconfirmed; the caller
+        # must then certify on a fresh gap and resume if that fails (Solver does, in _result).
+        self.confirm = True
+        self.unconfirmed = False
+        self.best_natural = np.inf  # the lowest natural residual of the last solve
+        self.stopped_by = None      # "time limit" or "stagnation" when the last solve ended so
         self.vecs = [problem.vec() for _ in range(6)]
         self.fourier = FourierPreconditioner(problem)
 
@@ -133,12 +140,18 @@ class PolonskyKeer:
         if not load_control:
             self.separation = self.target_separation
             self._interference_start(pressure, p, h)
-        self.history = History(operator)
+        self.history = History(problem)
         self.restarts = 0  # CG restarts: PK, nodes entered the contact set; BCCG, Polak-Ribiere beta <= 0
         max_it = tao.getMaximumIterations()
         rz_old, conjugate, fresh_needed = 1.0, False, True
         since_fresh = 0
+        if self.initial_displacement is not None:
+            self.initial_displacement.copy(displacement_vec)
+            # Not fresh: with confirm, convergence at once is still confirmed on a computed K p.
+            self.initial_displacement, fresh_needed, since_fresh = None, False, 1
+        self.unconfirmed = False
         iteration, reason = 0, PETSc.TAO.Reason.DIVERGED_MAXITS
+        self.best_natural, self.stopped_by, best_iteration = np.inf, None, 0
         while True:
             if fresh_needed or since_fresh >= self.refresh:
                 operator.displacement(pressure, displacement_vec)
@@ -153,18 +166,25 @@ class PolonskyKeer:
             gap += self.separation
             kkt = report(mpi, p, gap, n, pbar)
             converged = kkt.natural <= self.rtol and (kkt.load_error is None or kkt.load_error <= self.rtol)
-            if converged and not fresh:
+            if converged and not fresh and self.confirm:
                 fresh_needed = True  # confirm on a freshly computed K p before stopping
                 continue
             self.history.record(iteration, kkt.natural)
             tao.monitor(its=iteration, f=kkt.complementarity, res=kkt.natural, cnorm=kkt.load_error or 0.0)
             if converged:
                 reason = PETSc.TAO.Reason.CONVERGED_USER
+                self.unconfirmed = not fresh
                 break
+            if kkt.natural < self.best_natural:
+                self.best_natural, best_iteration = kkt.natural, iteration
             if iteration >= max_it:
                 break
             if self.history.out_of_time(self.max_seconds):
-                reason = PETSc.TAO.Reason.DIVERGED_USER
+                reason, self.stopped_by = PETSc.TAO.Reason.DIVERGED_USER, "time limit"
+                break
+            if iteration - best_iteration >= STAGNATION_ITERATIONS:
+                # Round-off in the gap bounds the residual from below (its floor); CG then wanders.
+                reason, self.stopped_by = PETSc.TAO.Reason.DIVERGED_USER, "stagnation"
                 break
             # The free set: the contact set, and under BCCG also the nodes out of contact that overlap.
             if bccg:

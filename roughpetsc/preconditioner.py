@@ -57,6 +57,7 @@ class FourierPreconditioner:
         self._mean_mode = (count, compliance)
         return compliance
 
+    @PETSc.Log.EventDecorator("RPFourierPC")  # -log_view: one application of B, its FFT pair included
     def apply(self, residual, out, contact, count, keep_load):
         """``out = B residual`` on local flat arrays; ``residual`` vanishes off the contact set.
 
@@ -127,6 +128,9 @@ class _RestrictedMat:
             residual[self.indices] = x.getArray(readonly=True)
         self.preconditioner.apply(residual, out, self.contact, self.count, keep_load=False)
         y.getArray()[...] = out if self.indices is None else out[self.indices]
+
+    def shift(self, mat, a):
+        """TAO's BNK Hessian perturbation (MatShift): B stays, a preconditioner of K serves K + a I too."""
 
     def createSubMatrix(self, mat, isrow, iscol, submat):
         context = _RestrictedMat(self.preconditioner, isrow)

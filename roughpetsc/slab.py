@@ -1,10 +1,13 @@
 """A hand-written slab-decomposed 2-D real FFT pair for several MPI ranks.
 
-Real space: each rank owns an equal block of rows (PETSc's ownership ranges,
-``local_rows``). Spectral space: each rank owns a block of columns of the full
-``rfft2`` spectrum, all rows, stored like the full spectrum (not transposed):
+Real space: each rank owns a block of rows (``local_rows``), as many as
+possible equal: the first ``n0 % size`` ranks get one extra row, the split of
+PETSc's ``PETSC_DECIDE`` (:func:`row_split`); the Vecs are created with these
+blocks as explicit local sizes, so PETSc's ownership ranges are exactly the row
+blocks. Spectral space: each rank owns a block of columns of the full ``rfft2``
+spectrum, all rows, stored like the full spectrum (not transposed):
 ``spectral_slice = (slice(None), slice(c0, c1))``. The ``n1 // 2 + 1`` spectral
-columns are split as evenly as possible (the first ranks get the extra ones).
+columns are split the same way (:func:`block_split`).
 
 The forward pass is a batched 1-D r2c along axis 1 over the local rows, an
 exchange, and a batched 1-D c2c along axis 0 over the local columns; the
@@ -22,19 +25,46 @@ Two exchanges:
 ``alltoall`` (any layout of ranks): the r2c output is packed into contiguous
     per-destination blocks (one numpy copy) and exchanged with
     ``MPI_Alltoallv``; received blocks are already the rows of the local
-    column slab. The inverse exchange sends contiguous row blocks and unpacks
-    into the r2c layout (one copy).
+    column slab (rank ``p``'s block lands at its first row ``row_starts[p]``).
+    The inverse exchange sends contiguous row blocks and unpacks into the r2c
+    layout (one copy).
 """
 
 import numpy as np
 
+from .errors import UserError
+from .fftw import planner_effort
 
-def column_split(columns, size):
-    """Balanced column blocks: (starts, counts) with the extra columns on the first ranks."""
-    counts = np.full(size, columns // size, dtype=int)
-    counts[: columns % size] += 1
-    starts = np.concatenate(([0], np.cumsum(counts)[:-1]))
+
+def block_split(count, size):
+    """Balanced blocks of ``count`` items over ``size`` ranks, the extra items on the first ranks.
+
+    The same split as PETSc's ``PetscSplitOwnership`` (``PETSC_DECIDE``):
+    rank ``r`` gets ``count // size + (r < count % size)`` items.
+
+    Returns
+    -------
+    starts, counts : ndarray of int, shape (size,)
+        First item and number of items of each rank.
+    """
+    counts = np.full(size, count // size, dtype=int)
+    counts[: count % size] += 1
+    starts = np.concatenate(([0], np.cumsum(counts)[:-1])).astype(int)
     return starts, counts
+
+
+def row_split(n0, size):
+    """The real-space row blocks of a grid of ``n0`` rows on ``size`` ranks: ``(starts, counts)``.
+
+    Raises
+    ------
+    UserError
+        If a rank would own no row (more ranks than rows).
+    """
+    if n0 < size:
+        raise UserError(f"-surface_N0/-surface_N: the grid has {n0} row(s), fewer than the {size} MPI ranks "
+                        "that share them (every rank needs at least one row)")
+    return block_split(n0, size)
 
 
 def _shares_memory(comm):
@@ -54,7 +84,7 @@ class SlabTransform:
     Parameters
     ----------
     grid : surfaces.Grid
-        ``grid.n0`` must be divisible by the number of ranks.
+        At least one row per rank and one spectral column (``n1 // 2 + 1``) per rank.
     comm : mpi4py.MPI.Comm
     effort : str
         FFTW planner flag.
@@ -76,10 +106,10 @@ class SlabTransform:
 
         n0, n1 = grid.shape
         size, rank = comm.Get_size(), comm.Get_rank()
-        if n0 % size:
-            raise ValueError(f"{n0} rows cannot be shared evenly by {size} ranks")
+        row_starts, row_counts = row_split(n0, size)
         if n1 // 2 + 1 < size:
-            raise ValueError(f"{n1 // 2 + 1} spectral columns cannot be shared by {size} ranks")
+            raise UserError(f"-surface_N: {n1} columns give {n1 // 2 + 1} spectral columns, fewer than the "
+                            f"{size} MPI ranks that share them")
         if exchange == "auto":
             exchange = "shared" if _shares_memory(comm) else "alltoall"
         if exchange not in ("shared", "alltoall"):
@@ -88,11 +118,11 @@ class SlabTransform:
         self.comm = comm
         self.shape = (n0, n1)
         half = n1 // 2 + 1
-        m0 = n0 // size
-        starts, counts = column_split(half, size)
+        rows = int(row_counts[rank])
+        starts, counts = block_split(half, size)
         c0, c1 = int(starts[rank]), int(starts[rank] + counts[rank])
-        self._m0, self._half, self._starts, self._counts = m0, half, starts, counts
-        self.local_rows = slice(rank * m0, (rank + 1) * m0)
+        self._local_row_count, self._starts, self._counts = rows, starts, counts
+        self.local_rows = slice(int(row_starts[rank]), int(row_starts[rank]) + rows)
         self.spectral_slice = (slice(None), slice(c0, c1))
         self._alignment = pyfftw.simd_alignment
         self._window = None
@@ -100,16 +130,18 @@ class SlabTransform:
         if exchange == "shared":
             rows_block, self.spectrum = self._shared_spectrum(n0, half, c0, c1)
         else:
-            rows_block = pyfftw.empty_aligned((m0, half), dtype="complex128")
+            rows_block = pyfftw.empty_aligned((rows, half), dtype="complex128")
             self.spectrum = pyfftw.empty_aligned((n0, c1 - c0), dtype="complex128")
-            # Forward: the r2c rows are packed into per-destination blocks (m0, counts[q]) here.
-            self._packed = pyfftw.empty_aligned(m0 * half, dtype="complex128")
-            self._send_counts = m0 * counts
-            self._send_displs = m0 * starts
-            self._recv_counts = np.full(size, m0 * (c1 - c0))
-            self._recv_displs = np.arange(size) * m0 * (c1 - c0)
+            # Forward: the r2c rows are packed into per-destination blocks (rows, counts[q]) here.
+            self._packed = pyfftw.empty_aligned(rows * half, dtype="complex128")
+            self._send_counts = rows * counts
+            self._send_displs = rows * starts
+            # From rank p come its row_counts[p] rows of our columns: rows row_starts[p]... of the slab.
+            self._recv_counts = row_counts * (c1 - c0)
+            self._recv_displs = row_starts * (c1 - c0)
         self._rows = rows_block
-        self.real = pyfftw.empty_aligned((m0, n1), dtype="float64")
+        self.real = pyfftw.empty_aligned((rows, n1), dtype="float64")
+        effort = planner_effort(effort)
         flags = (effort,)
         self._r2c = pyfftw.FFTW(self.real, rows_block, axes=(1,), direction="FFTW_FORWARD", flags=flags)
         self._c2r = pyfftw.FFTW(rows_block, self.real, axes=(1,), direction="FFTW_BACKWARD",
@@ -188,9 +220,10 @@ class SlabTransform:
 
     # --- the Alltoallv exchange ------------------------------------------------
     def _blocks(self):
-        m0 = self._m0
+        """Per destination rank: its block of the packed buffer, ``(rows, columns)``, and its column slice."""
+        rows = self._local_row_count
         for start, count in zip(self._starts, self._counts):
-            yield (self._packed[m0 * start: m0 * (start + count)].reshape(m0, count),
+            yield (self._packed[rows * start: rows * (start + count)].reshape(rows, count),
                    slice(start, start + count))
 
     def _alltoall_forward(self):

@@ -18,14 +18,12 @@ dataset ``per_surface/<name>`` in seed order).
 """
 
 import json
-import os
-import sys
 
 import numpy as np
 
 from . import asperities, spectra
 from .errors import UserError
-from .io import atomic_path, versions
+from .io import atomic_path, check_outputs, on_root, versions
 from .surfaces import SURFACE_OPTIONS, fractal_amplitude, from_options
 
 OPTIONS = [
@@ -70,11 +68,14 @@ def read_settings(options):
     if settings["ensemble"] > 0 and (options.getString("surface_file", "")
                                      or options.getString("surface_type", "fractal") != "fractal"):
         raise UserError("-stats_ensemble > 0 needs random surfaces (-surface_type fractal, no -surface_file)")
-    for key in ("json", "h5", "plot"):
-        folder = os.path.dirname(os.path.abspath(settings[key])) if settings[key] else ""
-        if folder and not os.path.isdir(folder):
-            raise UserError(f"-stats_{key} {settings[key]}: the folder {folder} does not exist")
     return settings
+
+
+def output_paths(settings):
+    """The files the run writes, as ``(option, path)``."""
+    plot = settings["plot"]
+    return [("stats_json", settings["json"]), ("stats_h5", settings["h5"]),
+            ("stats_plot", f"{plot}_h.png" if plot else ""), ("stats_plot", f"{plot}_p.png" if plot else "")]
 
 
 def surface_settings(options):
@@ -429,15 +430,22 @@ def run(options, comm):
     The result document (dict) on rank 0, None on the other ranks.
     Raises :class:`UserError` on bad input (on every rank).
     """
+    settings = read_settings(options)
+    # Rank 0 checks the files and writes them; a failure there is raised on every rank (no rank left waiting).
+    on_root(comm, check_outputs, output_paths(settings), options.getBool("overwrite", False),
+            [("surface_file", options.getString("surface_file", ""))])
     document = compute(options, comm)
-    if comm.rank == 0:
-        print(format_report(document), flush=True)
-        settings = document["settings"]
-        if settings["json"]:
-            write_json(settings["json"], document)
-        if settings["h5"]:
-            write_h5(settings["h5"], document)
-        if settings["plot"]:
-            plot_pdfs(settings["plot"], document)
-    comm.Barrier()
+    on_root(comm, report, document)
     return document
+
+
+def report(document):
+    """Print the summary and write the requested files (rank 0)."""
+    print(format_report(document), flush=True)
+    settings = document["settings"]
+    if settings["json"]:
+        write_json(settings["json"], document)
+    if settings["h5"]:
+        write_h5(settings["h5"], document)
+    if settings["plot"]:
+        plot_pdfs(settings["plot"], document)

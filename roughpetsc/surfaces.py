@@ -7,6 +7,7 @@ per length, as in the Fourier pair (2.1)/(2.2) of the seed.
 """
 
 from dataclasses import dataclass
+import json
 import os
 
 import numpy as np
@@ -133,11 +134,23 @@ def hertz_sphere(grid, radius):
 
 
 def load(path):
-    """Read a measured surface from ``.npy``, HDF5 (dataset ``surface``) or a text matrix.
+    """Read a surface from ``.npy``, HDF5 or a text matrix.
+
+    HDF5: the dataset ``surface`` (contact-mechanics-challenge layout) or
+    ``heights`` (a roughpetsc output, whose root attribute ``length`` records
+    the cell size ``[l0, l1]``).
+
+    Returns
+    -------
+    heights : ndarray (n0, n1), length units, zero mean.
+    length : float or None
+        The recorded cell length along axis 1 (x), length units; None if the
+        file does not record one.
 
     Raises :class:`UserError` naming the file if it is missing, unreadable or
-    not a finite 2-D array. The mean is not removed here (see :func:`validate`).
+    not a finite 2-D array.
     """
+    length = None
     if not os.path.isfile(path):
         raise UserError(f"-surface_file: no such file: {path}")
     suffix = os.path.splitext(path)[1].lower()
@@ -148,16 +161,21 @@ def load(path):
             import h5py
 
             with h5py.File(path, "r") as f:
-                if "surface" not in f:
-                    raise UserError(f"-surface_file {path}: no dataset 'surface' in the HDF5 file")
-                heights = f["surface"][()]
+                if "surface" in f:
+                    heights = f["surface"][()]
+                elif "heights" in f:
+                    heights = f["heights"][()]
+                    if "length" in f.attrs:
+                        length = float(json.loads(f.attrs["length"])[1])
+                else:
+                    raise UserError(f"-surface_file {path}: no dataset 'surface' or 'heights' in the HDF5 file")
         else:
             heights = np.loadtxt(path, ndmin=2)
     except UserError:
         raise
     except Exception as exc:  # any reader failure is the file's fault
         raise UserError(f"-surface_file {path}: cannot read it ({type(exc).__name__}: {exc})") from None
-    return validate(heights, f"-surface_file {path}")
+    return validate(heights, f"-surface_file {path}"), length
 
 
 def validate(heights, source):
@@ -185,8 +203,9 @@ def validate(heights, source):
 # Options of the surface, with defaults: the embedded default is a surface of
 # group #1 of Table 7.1, (k_l, k_s, H) = (16, 64, 0.8), m2 = 2e-4, N = 256.
 SURFACE_OPTIONS = [
-    ("surface_type", "fractal", "fractal | bisinusoid | wave | sphere (ignored with -surface_file)"),
-    ("surface_file", "", "read heights from PATH (.npy, .h5/.hdf5 dataset 'surface', or a text matrix)"),
+    ("surface_type", "fractal", "fractal | bisinusoid | wave | sphere (an error with -surface_file)"),
+    ("surface_file", "", "read heights from PATH (.npy, a text matrix, .h5/.hdf5 dataset 'surface', or a "
+                         "roughpetsc output: dataset 'heights' and its recorded cell length)"),
     ("surface_N", 256, "nodes per side (N x N grid)"),
     ("surface_N0", 0, "rows (axis 0) if different from -surface_N; e.g. a few rows for a 1-D wave"),
     ("surface_L", 1.0, "cell length along axis 1 (x); axis 0 gets L * N0 / N (square nodes)"),
@@ -199,6 +218,31 @@ SURFACE_OPTIONS = [
     ("surface_wavelength", 0.0, "bisinusoid/wave: wavelength along x (0 = the cell length)"),
     ("surface_radius", 10.0, "sphere: radius R of the paraboloid -r^2/(2R) [length]"),
 ]
+
+
+# The options each surface type reads besides the grid (-surface_N, -surface_N0, -surface_L).
+TYPE_OPTIONS = {
+    "fractal": ("surface_kl", "surface_ks", "surface_H", "surface_m2", "surface_seed"),
+    "bisinusoid": ("surface_amplitude", "surface_wavelength"),
+    "wave": ("surface_amplitude", "surface_wavelength"),
+    "sphere": ("surface_radius",),
+}
+
+
+def parameters(opts):
+    """The surface's parameters as used, defaults included: ``{option name: value}`` (for output files).
+
+    A surface read from a file is recorded by its path and -surface_L.
+    """
+    defaults = {name: default for name, default, _ in SURFACE_OPTIONS}
+    path = opts.getString("surface_file", "")
+    if path:
+        names = ("surface_file", "surface_L")
+    else:
+        kind = opts.getString("surface_type", "fractal")
+        names = ("surface_type", "surface_N", "surface_N0", "surface_L") + TYPE_OPTIONS.get(kind, ())
+    read = {int: opts.getInt, float: opts.getReal, str: opts.getString}
+    return {name: read[type(defaults[name])](name, defaults[name]) for name in names}
 
 
 def grid_from_options(opts):
@@ -223,8 +267,9 @@ def from_options(opts, seed=None):
     """
     path = opts.getString("surface_file", "")
     if path:
-        heights = load(path)
-        length = opts.getReal("surface_L", 1.0)
+        heights, recorded_length = load(path)
+        # An explicit -surface_L wins over the length a roughpetsc file records.
+        length = opts.getReal("surface_L", recorded_length or 1.0)
         if not (length > 0 and np.isfinite(length)):
             raise UserError(f"-surface_L must be a positive length, got {length}")
         n0, n1 = heights.shape

@@ -17,7 +17,11 @@ was 3.5x slower on 2 ranks here (studies/output/mpi_speedup.md).
 import numpy as np
 from petsc4py import PETSc
 
-from .errors import UserError
+from .fftw import planner_effort
+
+# PETSc log events (-log_view, prefix RP for roughpetsc): the operator applications by kind
+# (RPCompliance, RPStiffness), and every FFT pair (r2c, symbol product, c2r) whatever asked for it.
+log_event = PETSc.Log.EventDecorator
 
 
 def _wavenumber_modulus(grid, rows=slice(None), cols=slice(None)):
@@ -31,6 +35,7 @@ class _SerialTransform:
     def __init__(self, grid, threads, effort):
         import pyfftw
 
+        effort = planner_effort(effort)
         shape = grid.shape
         self._alignment = pyfftw.simd_alignment
         self.real = pyfftw.empty_aligned(shape, dtype="float64")
@@ -119,9 +124,6 @@ class Westergaard:
     def __init__(self, grid, E_star, comm=None, threads=1, effort="FFTW_MEASURE"):
         comm = comm or PETSc.COMM_WORLD
         size = comm.getSize()
-        if grid.n0 % size:
-            raise UserError(f"the grid has {grid.n0} rows, which {size} MPI ranks cannot share evenly: "
-                            "choose -surface_N0 (or -surface_N) divisible by the number of ranks")
         self.grid = grid
         self.E_star = float(E_star)
         self.comm = comm
@@ -164,6 +166,9 @@ class Westergaard:
     def vec(self):
         """A new distributed Vec laid out like the grid (rows owned by this rank).
 
+        The local size is given explicitly (this rank's rows times ``n1``), so
+        PETSc's ownership range is exactly ``local_rows`` however unevenly the
+        rows are shared (PETSC_DECIDE would split the ``n0 n1`` nodes, not rows).
         Its memory is SIMD-aligned, so that the FFTW plans (serial or slab) run
         on it in place (no copy per application).
         """
@@ -178,15 +183,21 @@ class Westergaard:
         array = v.getArray(readonly=readonly)
         return array.reshape(self.local_shape)
 
+    @log_event("RPCompliance")
     def displacement(self, pressure, out):
         """``out = K pressure``: surface displacement (3.33), zero mean, length units."""
         self.applications += 1
-        self._transform.filter(self.local(pressure, readonly=True), self.local(out), self._compliance)
+        self._filter(self.local(pressure, readonly=True), self.local(out), self._compliance)
+
+    @log_event("RPFFTPair")
+    def _filter(self, source, target, symbol):
+        self._transform.filter(source, target, symbol)
 
     def pressure_surface(self, heights, out):
         """``out = F^-1[pi E* |k| F[heights]]``: the complete-contact pressure p_c of (2.47)."""
-        self._transform.filter(self.local(heights, readonly=True), self.local(out), self._stiffness)
+        self._filter(self.local(heights, readonly=True), self.local(out), self._stiffness)
 
+    @log_event("RPStiffness")
     def stiffness(self, source, target):
         """``target = F^-1[pi E* max(|k|, 1/L) F[source]]`` on local ``(rows, n1)`` arrays.
 
@@ -196,7 +207,7 @@ class Westergaard:
         displacement control. Counts as an application.
         """
         self.applications += 1
-        self._transform.filter(source, target, self._preconditioner)
+        self._filter(source, target, self._preconditioner)
 
     def mat(self):
         """The compliance as a symmetric shell Mat (``MATPYTHON``); destroy it when done."""
@@ -213,16 +224,27 @@ class Westergaard:
 
 
 class _ShellContext:
-    """The MATPYTHON context of :meth:`Westergaard.mat`."""
+    """The MATPYTHON context of :meth:`Westergaard.mat`: K + perturbation I.
+
+    ``perturbation`` is TAO's Hessian shift: the BNK family (BNLS, BNTR, BNTL)
+    calls MatShift when a Newton step fails to descend, and expects the next
+    Hessian evaluation to start afresh (the owner sets ``perturbation`` back to 0).
+    """
 
     def __init__(self, operator):
         self.operator = operator
+        self.perturbation = 0.0
 
     def mult(self, mat, x, y):
         self.operator.displacement(x, y)
+        if self.perturbation:
+            y.axpy(self.perturbation, x)
 
     def multTranspose(self, mat, x, y):
-        self.operator.displacement(x, y)
+        self.mult(mat, x, y)
 
     def getDiagonal(self, mat, d):
-        d.set(self.operator.diagonal)
+        d.set(self.operator.diagonal + self.perturbation)
+
+    def shift(self, mat, a):
+        self.perturbation += a

@@ -108,6 +108,25 @@ def solve(problem, options, rtol, control="load", monitor=None, **load):
     return result, field, time.perf_counter() - start
 
 
+def load_rows(path):
+    """The rows a resumable study saved in ``path`` (JSON), or [] for a fresh start."""
+    import json
+
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        return json.load(f)
+
+
+def save_rows(path, rows):
+    """Rewrite the JSON rows of a resumable study atomically (a kill leaves the previous rows)."""
+    import json
+
+    with open(path + ".partial", "w") as f:
+        json.dump(rows, f, indent=0)
+    os.replace(path + ".partial", path)
+
+
 def markdown_table(header, rows):
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]

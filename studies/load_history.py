@@ -12,6 +12,17 @@ factor per iteration, see studies/output/convergence), so a step costs about log
 iterations, whatever its start residual r0. The table gives, beside the measured ratio, the ratio that
 a linear rate equal to the cold solve's predicts from the warm steps' own r0, and the r0 that every step
 would need for the whole history to cost 10 cold solves.
+
+Measured at N = 256 (issue 12 item 6; FFT pairs per warm step / FFT pairs of one cold solve at p* = 0.5):
+linear extrapolation in the load 0.490 (the predictor kept), previous solution scaled 0.587, quadratic 0.505,
+cubic 0.531, linear in log(load) 0.495, quadratic in log(load) 0.501, linear in sqrt(load) 0.492, the
+predicted gap's entering nodes given p = -g / K_00 0.513 (quadratic: 0.528); skipping the fresh K p after a
+projection while ||K delta||_inf <= 2 K_00 ||delta||_1 stays below 0.01 / 0.1 / 0.5 of the residual 0.491 /
+0.519 / 0.542 (more iterations). An oracle start, the exact next solution wherever the linear predictor is off
+by more than 1e-2 (1e-3) of pbar, gives 0.469 (0.326): the cost is set by the error spread over the contact
+set, not by the nodes entering contact. Kept: the start's K p from the kept K p of the previous solutions
+and no fresh confirming K p inside PK (Solver certifies on a fresh gap and resumes PK if that fails):
+2 FFT pairs less per step, 0.478.
 """
 
 import argparse

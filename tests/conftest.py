@@ -6,7 +6,17 @@ import sys
 
 import petsc4py
 
+# Every test plans its transforms afresh, as on a new machine: no wisdom from earlier runs.
+# ROUGHPETSC_FFT_EFFORT (FFTW_ESTIMATE, FFTW_MEASURE, FFTW_PATIENT) forces one planner effort on the
+# whole suite, subprocesses included; .ci/run runs the suite under two of them.
+os.environ.setdefault("ROUGHPETSC_FFT_WISDOM", "none")
+
 petsc4py.init([sys.argv[0]])
+
+
+def pytest_report_header(config):
+    effort = os.environ.get("ROUGHPETSC_FFT_EFFORT") or "as each test asks"
+    return f"roughpetsc: FFTW planner effort {effort}, wisdom cache {os.environ['ROUGHPETSC_FFT_WISDOM']}"
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",

@@ -66,16 +66,16 @@ def test_surface_from_files(tmp_path):
     np.savetxt(tmp_path / "s.txt", heights)
     areas = []
     for name in ("s.npy", "s.h5", "s.txt"):
-        out = run_cli(["-surface_file", tmp_path / name, "-json", tmp_path / "f.json"])
+        out = run_cli(["-surface_file", tmp_path / name, "-json", tmp_path / f"{name}.json"])
         assert out.returncode == 0, out.stderr
-        areas.append(json.load(open(tmp_path / "f.json"))["steps"][0]["A"])
+        areas.append(json.load(open(tmp_path / f"{name}.json"))["steps"][0]["A"])
     assert areas[0] == areas[1] == pytest.approx(areas[2], abs=2 / 32 ** 2)
 
 
 def test_help_lists_our_options():
     out = run_cli(["-help"])
     assert out.returncode == 0
-    for option in ("-surface_N", "-pstar_list", "-kkt_rtol", "-json", "-output", "-E_star", "-tao_type"):
+    for option in ("-surface_N", "-pstar_list", "-kkt_rtol", "-json", "-output", "-E_star", "-tao_type", "-overwrite"):
         assert option in out.stdout
 
 
@@ -142,11 +142,11 @@ def test_non_convergence_is_reported_with_petsc_reason(tmp_path):
     assert out.returncode == 3
     assert "NOT CONVERGED" in out.stdout
     step = json.load(open(tmp_path / "n.json"))["steps"][0]
-    assert not step["converged"] and step["reason"] == "DIVERGED_MAXITS" and step["kkt"]["natural"] > 1e-8
+    assert not step["converged"] and step["reason"].startswith("DIVERGED_MAXITS") and step["kkt"]["natural"] > 1e-8
 
 
 def test_time_limit_is_reported_as_not_converged(tmp_path):
     out = run_cli(SMALL + ["-pk_pc", "none", "-solve_max_time", 1e-9, "-json", tmp_path / "t.json"])
     assert out.returncode == 3
     step = json.load(open(tmp_path / "t.json"))["steps"][0]
-    assert not step["converged"] and step["reason"] == "DIVERGED_USER"
+    assert not step["converged"] and step["reason"].startswith("DIVERGED_USER")

@@ -129,3 +129,53 @@ def test_bnls_with_and_without_the_fourier_preconditioner_agree(problem):
             PETSc.Options().delValue("bound_pc")
         assert result.converged, result.reason
     assert np.abs(fields["fourier"] - fields["none"]).max() <= 1e-6 * fields["none"].max()
+
+
+def test_load_path_reuses_the_predicted_displacement_and_certifies_every_step(problem):
+    """Along a load path PK starts from the predictor's K p (a combination of the kept K p, not a fresh
+    FFT pair) and stops without its own fresh confirmation; every step is still certified on a fresh gap
+    by the Solver, equals a cold solve, and a failed certificate resumes PK."""
+    loads = [0.05, 0.1, 0.15, 0.2]
+    solver = Solver(problem, "load", None, 1e-9)
+    try:
+        for k, pstar in enumerate(loads):
+            target = problem.scaled_pbar(None, pstar)
+            if k >= 1:
+                # The start's K p from the predictor equals a fresh K p of the start (probed on copies).
+                pressure, previous = solver.pressure, solver.previous
+                solver.pressure = pressure.copy()
+                solver.previous = previous.copy() if previous is not None else None
+                predicted = solver._load_start(target)
+                assert predicted is not None
+                fresh = problem.vec()
+                problem.operator.displacement(solver.pressure, fresh)
+                scale = np.abs(problem.local(fresh)).max()
+                assert np.abs(problem.local(predicted) - problem.local(fresh)).max() <= 1e-12 * scale
+                for v in (fresh, solver.pressure, solver.previous):
+                    if v is not None:
+                        v.destroy()
+                solver.pressure, solver.previous = pressure, previous
+            warm = solver.solve(pstar=pstar)
+            assert warm.converged and warm.kkt.natural <= 1e-9
+            cold, cold_field = solve(problem, "load", None, "fourier", 1e-9, pstar=pstar)
+            field = solver.fields()[0]
+            assert np.abs(field - cold_field).max() <= 1e-6 * cold_field.max()
+            assert warm.gbar == pytest.approx(cold.gbar, rel=1e-7)
+        # A certificate that fails (here forced by a perturbed stop) resumes PK to a certified result.
+        backend_solve, calls = solver.backend.solve, []
+
+        def counted(target, pressure):
+            calls.append(target)
+            return backend_solve(target, pressure)
+
+        def perturbed(target, pressure):
+            outcome = counted(target, pressure)
+            solver.backend.solve = counted
+            problem.local(pressure)[...] *= 1.0 + 1e-3 * (problem.local(problem.heights, readonly=True) > 0)
+            return outcome
+
+        solver.backend.solve = perturbed
+        result = solver.solve(pstar=0.25)
+        assert len(calls) == 2 and result.converged and result.kkt.natural <= 1e-9
+    finally:
+        solver.destroy()

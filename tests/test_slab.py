@@ -1,4 +1,9 @@
-"""The hand-written slab FFT pair (roughpetsc.slab) against numpy's rfft2/irfft2 on 1, 2 and 4 ranks."""
+"""The hand-written slab FFT pair (roughpetsc.slab) against numpy's rfft2/irfft2 on 1 to 4 ranks.
+
+The grids include row counts that the ranks do not divide (the uneven slab
+path: the first ``n0 % size`` ranks own one extra row) and spectral column
+counts that they do not divide.
+"""
 
 import os
 import subprocess
@@ -7,7 +12,8 @@ import sys
 import numpy as np
 import pytest
 
-from roughpetsc.slab import SlabTransform, column_split
+from roughpetsc.errors import UserError
+from roughpetsc.slab import SlabTransform, block_split, row_split
 from roughpetsc.surfaces import Grid
 
 from conftest import MPI_ENV, ROOT
@@ -16,23 +22,44 @@ from conftest import MPI_ENV, ROOT
 DRIVER = r"""
 import sys
 import numpy as np
+import petsc4py
+petsc4py.init(sys.argv[:1])
 import pyfftw
 from mpi4py import MPI
-from roughpetsc.slab import SlabTransform
+from petsc4py import PETSc
+from roughpetsc.slab import SlabTransform, row_split
 from roughpetsc.surfaces import Grid
+from roughpetsc.westergaard import Westergaard
 
 world = MPI.COMM_WORLD
+size, rank = world.Get_size(), world.Get_rank()
+# The row blocks are PETSc's own split (PETSC_DECIDE) of n0 items, and the operator's Vecs
+# (explicit local sizes) are owned exactly by those row blocks.
+for n0, n1 in ((62, 64), (66, 10), (13, 8), (64, 64)):
+    starts, counts = row_split(n0, size)
+    first, last = int(starts[rank]), int(starts[rank] + counts[rank])
+    decided = PETSc.Vec().createMPI(n0, comm=PETSc.COMM_WORLD)
+    assert decided.getOwnershipRange() == (first, last), (decided.getOwnershipRange(), first, last)
+    decided.destroy()
+    operator = Westergaard(Grid(n0, n1), 1.0, PETSc.COMM_WORLD, effort="FFTW_ESTIMATE")
+    assert operator.local_rows == slice(first, last)
+    v = operator.vec()
+    assert v.getOwnershipRange() == (first * n1, last * n1) and v.getSize() == n0 * n1
+    v.destroy()
+    operator.destroy()
 # On 4 ranks also two groups of 2 (as an ensemble splits the ranks): each group transforms on its own.
 comms = [world] + ([world.Split(world.Get_rank() // 2, world.Get_rank())] if world.Get_size() == 4 else [])
 worst = 0.0
 for comm, exchange in [(c, e) for c in comms for e in ("shared", "alltoall")]:
     for shape, lengths in (((8, 8), (1.0, 1.0)), ((16, 10), (1.0, 2.0)), ((12, 9), (1.0, 1.0)),
-                           ((64, 96), (0.75, 1.0)), ((256, 256), (1.0, 1.0)), ((32, 6), (1.0, 1.0))):
-        if shape[0] % comm.Get_size():
-            continue
+                           ((64, 96), (0.75, 1.0)), ((256, 256), (1.0, 1.0)), ((32, 6), (1.0, 1.0)),
+                           ((62, 64), (1.0, 1.0)), ((66, 64), (1.0, 1.0)), ((13, 11), (1.3, 1.0)), ((5, 8), (1.0, 1.0))):
         grid = Grid(*shape, *lengths)
         transform = SlabTransform(grid, comm, "FFTW_ESTIMATE", exchange)
         rows, spectral = transform.local_rows, transform.spectral_slice
+        # Every row and every spectral column is owned by exactly one rank.
+        assert comm.allreduce(rows.stop - rows.start) == shape[0]
+        assert comm.allreduce(spectral[1].stop - spectral[1].start) == shape[1] // 2 + 1
         x = np.random.default_rng(7).standard_normal(shape) + 3.0
         X = np.fft.rfft2(x)
         # The symbol as roughpetsc.westergaard builds it from spectral_slice.
@@ -84,18 +111,25 @@ def run_driver(ranks, tmp_path):
     return subprocess.run(command, capture_output=True, text=True, env=env, timeout=300, cwd=ROOT)
 
 
-@pytest.mark.parametrize("ranks", [1, 2, 4])
+@pytest.mark.parametrize("ranks", [1, 2, 3, 4])
 def test_slab_pair_matches_numpy(ranks, tmp_path):
     done = run_driver(ranks, tmp_path)
     assert done.returncode == 0, done.stdout + done.stderr
     assert "worst" in done.stdout
 
 
-def test_column_split_is_balanced():
-    starts, counts = column_split(1025, 2)
+def test_block_split_is_balanced():
+    starts, counts = block_split(1025, 2)
     assert list(counts) == [513, 512] and list(starts) == [0, 513]
-    starts, counts = column_split(6, 4)
+    starts, counts = block_split(6, 4)
     assert list(counts) == [2, 2, 1, 1] and list(starts) == [0, 2, 4, 5]
+    starts, counts = row_split(62, 3)
+    assert list(counts) == [21, 21, 20] and list(starts) == [0, 21, 42]
+
+
+def test_fewer_rows_than_ranks_is_refused_by_name():
+    with pytest.raises(UserError, match="-surface_N0/-surface_N"):
+        row_split(3, 4)
 
 
 def test_one_rank_in_process_and_bad_sizes():

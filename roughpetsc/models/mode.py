@@ -5,12 +5,11 @@ Options are read only through ``PETSc.Options`` getters so that PETSc's
 """
 
 import json
-import os
 
 import numpy as np
 
 from ..errors import UserError
-from ..io import atomic_path
+from ..io import atomic_path, check_figure_format, check_outputs, on_root
 
 OPTIONS = [
     ("models_alpha_h", 2.0, "bandwidth alpha^h of the surface (2.16), > 1.5"),
@@ -58,10 +57,6 @@ def _validate(o):
     from .curvefit import TABLE_8_4
     if o["models_group"] not in TABLE_8_4:
         raise UserError("-models_group must be one of %s" % sorted(TABLE_8_4))
-    for key in ("models_json", "models_plot"):
-        path = o[key]
-        if path and not os.path.isdir(os.path.dirname(os.path.abspath(path))):
-            raise UserError("-%s: directory of %r does not exist" % (key, path))
 
 
 def compute(o):
@@ -117,11 +112,22 @@ def plot(curves, path):
 
 
 def run(options, comm):
-    """Entry point of ``python -m roughpetsc -mode models`` (work on rank 0)."""
+    """Entry point of ``python -m roughpetsc -mode models``.
+
+    The work is done on rank 0; its errors (files that cannot be written) are
+    raised on every rank. Returns the curves on rank 0, None elsewhere.
+    """
     o = _read(options)
     _validate(o)
-    if comm.Get_rank() != 0:
-        return None
+    on_root(comm, check_outputs, [("models_json", o["models_json"]), ("models_plot", o["models_plot"])],
+            options.getBool("overwrite", False))
+    if o["models_plot"]:  # after the path checks, which name a folder as such
+        check_figure_format(o["models_plot"], "models_plot")
+    return on_root(comm, _compute_and_write, o)
+
+
+def _compute_and_write(o):
+    """Compute, print and write the curves (rank 0)."""
     curves = compute(o)
     print("models: alpha_h = %g, alpha_p = %g" % (o["models_alpha_h"], o["models_alpha_p"]))
     print("%-16s %10s %10s %10s" % ("early model", "d*", "p*", "A*"))
