@@ -34,7 +34,9 @@ class ContactProblem:
     grid : surfaces.Grid
         The periodic cell (length units).
     heights : ndarray (n0, n1)
-        The whole surface with zero mean (every rank passes the same array).
+        The whole surface (every rank passes the same array). Its mean is removed: the mean height
+        only shifts the rigid separation, and every scale (sqrt(m0^h), the bracket of the separation,
+        p*) is that of the zero-mean surface.
     E_star : float
         Composite modulus E* (1.6), pressure units.
     comm : petsc4py.PETSc.Comm
@@ -56,6 +58,7 @@ class ContactProblem:
         self.grid = grid
         self.E_star = float(E_star)
         self.n = grid.size
+        heights = heights - np.mean(heights)
         self.height_scale = float(np.sqrt(np.mean(heights ** 2)))
         self.pressure_scale = self.E_star * self.height_scale / grid.l1
         self.scaled_grid = Grid(grid.n0, grid.n1, grid.l0 / grid.l1, 1.0)

@@ -323,6 +323,8 @@ class RootFind:
             state["inner"], state["separation"] = outcome.reason, d
             mean_p = pressure.sum() / problem.n
             if abs(mean_p - pbar) <= self.rtol * pbar:
+                if not outcome.reason.startswith("CONVERGED"):
+                    state["stop"] = "DIVERGED_ROOT_INNER"  # the load is met, the inner QP is not solved
                 raise Found
             if state["evaluations"] >= self.max_evaluations:
                 state["stop"] = "DIVERGED_ROOT_MAXFCN"
@@ -531,6 +533,8 @@ class Solver:
         self.gap = problem.vec()
         self.last_separation = None
         self.solved_targets = []  # scaled loads of the solutions in (previous, pressure)
+        # PK's load paths: K p of the solutions in solved_targets, K p of the start, every Vec made for them.
+        self._displacements, self._start_displacement, self._displacement_pool = [], None, []
 
     def solve(self, pbar=None, pstar=None, gbar=None):
         """Solve one load; the previous solution is the start. Returns a :class:`Result`."""
@@ -593,8 +597,6 @@ class Solver:
 
         Load control by PK only; the kept K p follow ``solved_targets``.
         """
-        if not hasattr(self, "_displacement_pool"):
-            self._displacement_pool, self._displacements = [], []  # every Vec made (destroy), the kept ones
         if target is None or self.control != "load" or not isinstance(self.backend, PKSolve):
             self._displacements = []
             return
@@ -622,11 +624,9 @@ class Solver:
         load, linear or quadratic in log or sqrt of the load, the predicted gap's entering nodes) started
         no closer: see studies/load_history.py.
         """
-        if not hasattr(self, "_displacement_pool"):
-            self._displacement_pool, self._displacements = [], []  # every Vec made (destroy), the kept K p
         displacements = self._displacements
         known = isinstance(self.backend, PKSolve) and len(displacements) == len(self.solved_targets)
-        if known and not hasattr(self, "_start_displacement"):
+        if known and self._start_displacement is None:
             self._start_displacement = self.problem.vec()
             self._displacement_pool.append(self._start_displacement)
         if self.solved_targets and self.previous is None:
@@ -681,6 +681,11 @@ class Solver:
         kkt = report(problem.mpi, p, g, problem.n, target)
         measures = measure(problem, p, g)
         converged = kkt.natural <= self.rtol and (kkt.load_error is None or kkt.load_error <= self.rtol)
+        reason = outcome.reason
+        if not converged and reason.startswith(("CONVERGED", "COMPLETE")):
+            # The solver's own test passed on its own gap; the certificate on a fresh one did not.
+            load = "" if kkt.load_error is None else f", load error {kkt.load_error:.2g}"
+            reason = f"NOT_CERTIFIED ({reason}, but on a fresh gap: natural residual {kkt.natural:.2g}{load})"
         pbar = measures["pbar"] * problem.pressure_scale
         gbar = measures["gbar"] * problem.height_scale
         return Result(
@@ -688,7 +693,7 @@ class Solver:
             gbar=gbar, gstar=gbar / problem.sqrt_m0h, separation=outcome.separation * problem.height_scale,
             rms_gap_contact=measures["rms_gap_contact"] * problem.height_scale, kkt=kkt,
             iterations=outcome.iterations, operator_applications=problem.operator.applications - applications,
-            time_s=time.perf_counter() - start, reason=outcome.reason, converged=converged, solver=self.name,
+            time_s=time.perf_counter() - start, reason=reason, converged=converged, solver=self.name,
             control=self.control, history=outcome.history)
 
     def fields(self):
@@ -702,6 +707,6 @@ class Solver:
         self.pressure.destroy()
         if self.previous is not None:
             self.previous.destroy()
-        for v in getattr(self, "_displacement_pool", []):
+        for v in self._displacement_pool:
             v.destroy()
         self.gap.destroy()
