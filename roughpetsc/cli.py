@@ -407,8 +407,13 @@ def main(argv=None):
 
     # Before PETSc starts: it reads the options files, and prints its own -help, as it is initialised.
     argv, preset_error = resolve_presets(sys.argv if argv is None else argv)
-    if any(item in ("-help", "--help") for item in argv[1:]) and launcher_rank() == 0:
-        print_help(_mode_modules())
+    if any(item in ("-help", "--help") for item in argv[1:]):
+        # Help piped into `head` or `less` ends quietly when the reader stops, as any Unix tool does,
+        # instead of in PETSc's SIGPIPE handler.
+        signal.signal(signal.SIGPIPE, signal.SIG_DFL)
+        argv = [*argv, "-no_signal_handler"]
+        if launcher_rank() == 0:
+            print_help(_mode_modules())
     petsc4py.init(argv)
     from petsc4py import PETSc
 

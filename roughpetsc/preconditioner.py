@@ -58,12 +58,14 @@ class FourierPreconditioner:
         return compliance
 
     @PETSc.Log.EventDecorator("RPFourierPC")  # -log_view: one application of B, its FFT pair included
-    def apply(self, residual, out, contact, count, keep_load):
+    def apply(self, residual, out, contact, count, keep_load, rigid_compliance=np.inf):
         """``out = B residual`` on local flat arrays; ``residual`` vanishes off the contact set.
 
         ``contact`` is 1.0 on C and 0.0 elsewhere, ``count`` the global |C|.
         ``keep_load``: load control; the residual must then have zero mean on
         C, and the mean-mode term is dropped (directions keep the mean pressure).
+        ``rigid_compliance``: the lambda_C to use when C is every node, where K 1 = 0 (the uniform
+        pressure is the rigid mode); infinite drops the mean mode there, as PK wants.
         """
         problem = self.problem
         operator = problem.operator
@@ -83,6 +85,8 @@ class FourierPreconditioner:
         out *= contact
         if not keep_load:
             compliance = self.mean_mode_compliance(contact, count)
+            if not np.isfinite(compliance):
+                compliance = rigid_compliance
             out += MEAN_MODE_WEIGHT * residual_mean / compliance * contact
 
     # --- as a TAO Hessian preconditioning matrix --------------------------
@@ -103,7 +107,7 @@ class FourierPreconditioner:
 class _RestrictedMat:
     """MATPYTHON context: ``B`` on the free set given by an IS of global indices (None: every node)."""
 
-    def __init__(self, preconditioner, free):
+    def __init__(self, preconditioner, free, rigid_compliance=None):
         self.preconditioner = preconditioner
         problem = preconditioner.problem
         self.residual = problem.vec()
@@ -117,6 +121,11 @@ class _RestrictedMat:
             self.indices = free.getIndices() - start
             self.contact[self.indices] = 1.0
         self.count, = allsum(problem.mpi, [self.contact.sum()])
+        # With every node free, K is singular (K 1 = 0) and a TAO Newton type shifts it, K + a I: the
+        # mean mode is then preconditioned by 1 / a, or, before any shift, by the compliance of the
+        # longest wavelength, so that B stays positive definite (a singular B broke BNLS/BNTR's CG).
+        grid = problem.scaled_grid  # scaled units: E* = 1
+        self.rigid_compliance = rigid_compliance or max(grid.l0, grid.l1) / np.pi
 
     def mult(self, mat, x, y):
         residual = self.residual.getArray()
@@ -126,14 +135,17 @@ class _RestrictedMat:
         else:
             residual[...] = 0.0
             residual[self.indices] = x.getArray(readonly=True)
-        self.preconditioner.apply(residual, out, self.contact, self.count, keep_load=False)
+        self.preconditioner.apply(residual, out, self.contact, self.count, keep_load=False,
+                                  rigid_compliance=self.rigid_compliance)
         y.getArray()[...] = out if self.indices is None else out[self.indices]
 
     def shift(self, mat, a):
-        """TAO's BNK Hessian perturbation (MatShift): B stays, a preconditioner of K serves K + a I too."""
+        """TAO's BNK Hessian perturbation (MatShift): the rigid mode of K + a I has compliance 1 / a."""
+        if a > 0:
+            self.rigid_compliance = 1.0 / a
 
     def createSubMatrix(self, mat, isrow, iscol, submat):
-        context = _RestrictedMat(self.preconditioner, isrow)
+        context = _RestrictedMat(self.preconditioner, isrow, self.rigid_compliance)
         if submat is not None:  # MAT_REUSE_MATRIX: same sizes, new free set
             submat.getPythonContext().destroy(submat)
             submat.setPythonContext(context)

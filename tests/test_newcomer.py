@@ -7,6 +7,8 @@ import hashlib
 import json
 import os
 import stat
+import subprocess
+import sys
 
 import h5py
 import pytest
@@ -241,6 +243,15 @@ def test_help_prints_our_options_and_presets_before_petsc(tmp_path):
         assert text in out.stdout
     assert ours < out.stdout.index("Presets") < out.stdout.index("Petsc Release")
     assert "ignored with -surface_file" not in out.stdout
+
+
+def test_help_into_a_pager_that_stops_early_ends_quietly():
+    """`-help | head` closes the pipe while help is still printing: no PETSc crash banner."""
+    command = f"{sys.executable} -m roughpetsc -help | head -n 2"
+    out = subprocess.run(["bash", "-c", command], capture_output=True, text=True, cwd=ROOT, timeout=120,
+                         env=dict(os.environ, PYTHONPATH=ROOT))
+    assert out.stdout.startswith("roughpetsc options")
+    assert "PETSC ERROR" not in out.stderr and "MPI_ABORT" not in out.stderr, out.stderr
 
 
 def test_the_entry_point_exists():
