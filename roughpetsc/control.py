@@ -293,6 +293,12 @@ class RootFind:
     so [0, max h] brackets the root and no solve is needed at its ends. Brent's
     method (scipy) narrows it; every inner solve starts from the previous
     pressure. The search stops when |P(d) - pbar| / pbar <= rtol.
+
+    Near complete contact P changes so fast with d that the bracket can reach
+    round-off in d before the load is met. The solution is affine in d while
+    the contact set stays the same (K_CC p_C = h_C - d), so the search then
+    interpolates to the load between its closest solutions on either side of
+    it; the result is kept if it meets the tolerance on a fresh gap.
     """
 
     def __init__(self, problem, tao_type, rtol, max_evaluations=100):
@@ -301,6 +307,8 @@ class RootFind:
         self.rtol = rtol
         self.max_evaluations = max_evaluations
         self.tao_type = self.qp.tao_type
+        self.bracket = {"above": problem.vec(), "below": problem.vec()}  # solutions either side of the load
+        self.trial, self.gap = problem.vec(), problem.vec()
 
     def solve(self, pbar, pressure, separation_guess=None):
         from scipy.optimize import brentq
@@ -322,6 +330,9 @@ class RootFind:
             state["evaluations"] += 1
             state["inner"], state["separation"] = outcome.reason, d
             mean_p = pressure.sum() / problem.n
+            side = "above" if mean_p > pbar else "below"  # the closest solutions on each side of the load
+            pressure.copy(self.bracket[side])
+            state[side] = (d, mean_p)
             if abs(mean_p - pbar) <= self.rtol * pbar:
                 if not outcome.reason.startswith("CONVERGED"):
                     state["stop"] = "DIVERGED_ROOT_INNER"  # the load is met, the inner QP is not solved
@@ -345,8 +356,13 @@ class RootFind:
             pass
         if state["separation"] is None:
             state["separation"] = self.qp.separation
+        interpolated = state["stop"] in ("DIVERGED_ROOT_TOLERANCE", "DIVERGED_ROOT_MAXFCN") and \
+            "above" in state and "below" in state and self._interpolate(pbar, pressure, state)
         load_error = abs(pressure.sum() / problem.n - pbar) / pbar
-        if state["stop"] is None:
+        if interpolated:
+            reason = (f"CONVERGED_ROOT ({state['evaluations']} inner solves; the bracket on d reached round-off, "
+                      "the solutions either side of the load interpolated to it)")
+        elif state["stop"] is None:
             reason = f"CONVERGED_ROOT ({state['evaluations']} inner solves)"
         else:
             notes = [f"{state['evaluations']} inner solves", f"load error {load_error:.2g}"]
@@ -357,8 +373,33 @@ class RootFind:
             reason = f"{state['stop']} ({', '.join(notes)})"
         return Outcome(state["separation"], state["iterations"], reason, history.as_array())
 
+    def _interpolate(self, pbar, pressure, state):
+        """Replace ``pressure`` by the interpolation to the load of the solutions either side of it.
+
+        Returns True when the interpolated pressure meets the tolerance on a fresh gap (one operator
+        application) and has been put in ``pressure`` and ``state["separation"]``.
+        """
+        problem = self.problem
+        (d_above, mean_above), (d_below, mean_below) = state["above"], state["below"]
+        t = (pbar - mean_below) / (mean_above - mean_below)
+        separation = d_below + t * (d_above - d_below)
+        above, below = self.bracket["above"], self.bracket["below"]
+        self.trial.waxpy(-1.0, below, above)  # p_above - p_below
+        self.trial.aypx(t, below)             # p_below + t (p_above - p_below)
+        local = problem.local(self.trial)
+        np.maximum(local, 0.0, out=local)
+        problem.gap(self.trial, separation, self.gap)
+        kkt = report(problem.mpi, local, problem.local(self.gap, readonly=True), problem.n, pbar)
+        if not (kkt.natural <= self.rtol and kkt.load_error <= self.rtol):
+            return False
+        self.trial.copy(pressure)
+        state["separation"] = separation
+        return True
+
     def destroy(self):
         self.qp.destroy()
+        for v in (*self.bracket.values(), self.trial, self.gap):
+            v.destroy()
 
 
 class ALMMLoad:
