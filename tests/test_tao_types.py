@@ -11,17 +11,23 @@ from roughpetsc.surfaces import Grid, fractal
 TYPES = ["blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bnls", "bntr", "tron", "gpcg"]
 
 
-@pytest.fixture(scope="module")
-def reference():
-    """Load control by Polonsky-Keer at p* = 0.5 on a 128^2 group-#1 surface, solved to 1e-12."""
-    grid = Grid(128, 128)
-    problem = ContactProblem(grid, fractal(grid, 16, 64, 0.8, 2e-4, 7), 1.0, PETSc.COMM_SELF,
+def _pk_reference(n, k_l, k_s):
+    """Load control by Polonsky-Keer at p* = 0.5 on an n^2 fractal surface, solved to 1e-12."""
+    grid = Grid(n, n)
+    problem = ContactProblem(grid, fractal(grid, k_l, k_s, 0.8, 2e-4, 7), 1.0, PETSc.COMM_SELF,
                              fft_effort="FFTW_ESTIMATE")
     solver = Solver(problem, "load", None, 1e-12)
     result = solver.solve(pstar=0.5)
     pressure = solver.fields()[0].copy()
     solver.destroy()
     assert result.converged
+    return problem, result, pressure
+
+
+@pytest.fixture(scope="module")
+def reference():
+    """The group-#1 surface on 128^2."""
+    problem, result, pressure = _pk_reference(128, 16, 64)
     yield problem, result, pressure
     problem.destroy()
 
@@ -44,14 +50,7 @@ def test_type_converges_to_the_pk_pressure(reference, tao_type):
 @pytest.fixture(scope="module")
 def small_reference():
     """The reference on 64^2 (ALMM costs tens of thousands of operator applications on 128^2)."""
-    grid = Grid(64, 64)
-    problem = ContactProblem(grid, fractal(grid, 4, 16, 0.8, 2e-4, 7), 1.0, PETSc.COMM_SELF,
-                             fft_effort="FFTW_ESTIMATE")
-    solver = Solver(problem, "load", None, 1e-12)
-    result = solver.solve(pstar=0.5)
-    pressure = solver.fields()[0].copy()
-    solver.destroy()
-    assert result.converged
+    problem, result, pressure = _pk_reference(64, 4, 16)
     yield problem, result, pressure
     problem.destroy()
 
