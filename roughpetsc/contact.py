@@ -88,15 +88,13 @@ class ContactProblem:
         out.axpy(-1.0, self.heights)
         out.shift(separation)
 
-    def contact_separation(self, pressure, displacement):
+    def contact_separation(self, pressure, elastic_gap):
         """The rigid separation d for which the gap has zero mean on the contact set (PK's choice).
 
-        ``displacement`` is ``K p`` (local array of this rank).
+        ``elastic_gap`` is ``K p - h``, the gap at d = 0 (local array of this rank).
         """
-        p = self.local(pressure, readonly=True)
-        h = self.local(self.heights, readonly=True)
-        in_contact = p > 0
-        sums = allsum(self.mpi, [np.sum((displacement - h)[in_contact]), np.count_nonzero(in_contact)])
+        in_contact = self.local(pressure, readonly=True) > 0
+        sums = allsum(self.mpi, [np.sum(elastic_gap[in_contact]), np.count_nonzero(in_contact)])
         return -sums[0] / sums[1] if sums[1] else self.max_height
 
     # --- units --------------------------------------------------------------

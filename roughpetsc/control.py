@@ -134,10 +134,15 @@ class QuadraticObjective:
     the step, and after a restart the values TAO compares are as small as the decrease left.
 
     The last point and its gap are cached: :meth:`gap_of` of the last evaluated point costs nothing.
+
+    ``increments=False`` evaluates f directly instead. ALMM wants that: its augmented-Lagrangian
+    updates use the size of f, and with f measured from the start it took 26272 operator
+    applications instead of 14976 (128^2, p* = 0.5, 1e-8).
     """
 
-    def __init__(self, problem):
+    def __init__(self, problem, increments=True):
         self.problem = problem
+        self.increments = increments
         self.separation = 0.0
         self.value = 0.0
         self.point, self.gap, self.step = problem.vec(), problem.vec(), problem.vec()
@@ -151,11 +156,17 @@ class QuadraticObjective:
 
     def evaluate(self, x, out):
         """``out = g(x)`` (one operator application); returns f(x)."""
-        if self.cached:
+        if not self.increments:
+            self.problem.gap(x, self.separation, out)
+            self.value = 0.5 * (x.dot(out) + self.separation * x.sum() - x.dot(self.problem.heights))
+        elif self.cached:
             self.step.waxpy(-1.0, self.point, x)
             increment = self.step.dot(self.gap)
-        self.problem.gap(x, self.separation, out)
-        self.value = self.value + 0.5 * (increment + self.step.dot(out)) if self.cached else 0.0
+            self.problem.gap(x, self.separation, out)
+            self.value += 0.5 * (increment + self.step.dot(out))
+        else:
+            self.problem.gap(x, self.separation, out)
+            self.value = 0.0
         x.copy(self.point)
         if out is not self.gap:
             out.copy(self.gap)
@@ -421,7 +432,7 @@ class ALMMLoad:
         rows = 1 if comm.getRank() == 0 else 0
         self.gradient = problem.vec()
         self.gap_vec = problem.vec()
-        self.objective = QuadraticObjective(problem)  # at separation 0: f = p'Kp/2 - p'h
+        self.objective = QuadraticObjective(problem, increments=False)  # at separation 0: f = p'Kp/2 - p'h
         self.hessian = problem.operator.mat()
         self.lower = problem.vec()
         self.lower.set(0.0)
@@ -461,12 +472,10 @@ class ALMMLoad:
     def gap_of(self, x):
         """The gap of ``x`` at the separation that zeroes its mean on the contact set (PK's choice)."""
         problem = self.problem
+        elastic_gap = self.objective.gap_of(x)  # K p - h
+        self.separation = problem.contact_separation(x, elastic_gap)
         gap = problem.local(self.gap_vec)
-        np.copyto(gap, self.objective.gap_of(x))  # K p - h
-        in_contact = problem.local(x, readonly=True) > 0
-        gap_sum, count = allsum(problem.mpi, [gap[in_contact].sum(), np.count_nonzero(in_contact)])
-        self.separation = -gap_sum / count if count else problem.max_height
-        gap += self.separation
+        np.add(elastic_gap, self.separation, out=gap)
         return gap
 
     def solve(self, pbar, pressure):

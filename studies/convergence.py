@@ -45,11 +45,10 @@ def composite_run(problem, options, pstar):
 
     def gap_of(x):
         problem.operator.displacement(x, scratch)
-        displacement = problem.local(scratch)
-        separation = problem.contact_separation(x, displacement)
-        displacement -= problem.local(problem.heights, readonly=True)
-        displacement += separation
-        return displacement.ravel()
+        gap = problem.local(scratch)
+        gap -= problem.local(problem.heights, readonly=True)
+        gap += problem.contact_separation(x, gap)
+        return gap.ravel()
 
     def natural_of(x, g):
         return report(problem.mpi, x.getArray(readonly=True), g, problem.n, target).natural

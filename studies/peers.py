@@ -86,9 +86,8 @@ class Evaluator:
         p = problem.local(self.pressure)
         p[...] = pressure_field[problem.local_rows] / problem.pressure_scale
         problem.operator.displacement(self.pressure, self.work)
-        displacement = problem.local(self.work)
-        d = problem.contact_separation(self.pressure, displacement)
-        gap = displacement - problem.local(problem.heights, readonly=True) + d
+        gap = problem.local(self.work) - problem.local(problem.heights, readonly=True)
+        gap += problem.contact_separation(self.pressure, gap)
         p = problem.local(self.pressure, readonly=True)
         kkt = report(problem.mpi, p, gap, problem.n, self.target)
         m = measure(problem, p, gap)
