@@ -1,4 +1,4 @@
-"""Asperities (summits) of a surface and their probability densities (seed sec. 2.4-2.6, 7.2.2).
+"""Asperities (summits) of a surface and their probability densities (the dissertation, sec. 2.4-2.6, 7.2.2).
 
 A summit is a node strictly higher than its eight nearest neighbours on the
 periodic grid (sec. 7.2.2). At a summit the second derivatives are taken by

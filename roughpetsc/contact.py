@@ -15,10 +15,13 @@ import math
 import numpy as np
 from petsc4py import PETSc
 
-from .errors import UserError
+from .errors import ParameterError
 from .kkt import KKTReport, allsum, allmin
 from .surfaces import Grid
+from .love import FreeBoundary
 from .westergaard import Westergaard
+
+BOUNDARIES = ("periodic", "free")
 
 # Perimeter correction of the node-count contact area, Yastrebov, Anciaux and
 # Molinari, Tribol. Int. 114 (2017): A = A_nodes - c P_d dx with the staircase
@@ -34,14 +37,22 @@ class ContactProblem:
     grid : surfaces.Grid
         The periodic cell (length units).
     heights : ndarray (n0, n1)
-        The whole surface (every rank passes the same array). Its mean is removed: the mean height
+        The whole surface, length units (every rank passes the same array). Its mean is removed: the mean height
         only shifts the rigid separation, and every scale (sqrt(m0^h), the bracket of the separation,
         p*) is that of the zero-mean surface.
     E_star : float
         Composite modulus E* (1.6), pressure units.
     comm : petsc4py.PETSc.Comm
     fft_threads, fft_effort :
-        Passed to :class:`~roughpetsc.westergaard.Westergaard`.
+        Passed to the operator.
+    boundary : "periodic" or "free"
+        ``periodic``: the cell repeats (the Westergaard compliance (3.33)); ``free``: an isolated
+        body, nothing outside the grid (Love's coefficients (3.31) by a padded FFT,
+        :class:`~roughpetsc.love.FreeBoundary`). Under ``free`` the mean gap is not the rigid
+        separation, no load gives complete contact exactly, and p* still uses sqrt(m0^p) of the
+        pressure surface (2.47) of the heights, a statistic of the surface.
+    hardness : float or None
+        The hardness cap H, pressure units: perfect plasticity as ``0 <= p <= H`` (None: none).
 
     Attributes
     ----------
@@ -50,9 +61,16 @@ class ContactProblem:
         solver of this problem records (:class:`~roughpetsc.kkt.History`); None by default.
     """
 
-    def __init__(self, grid, heights, E_star, comm=None, fft_threads=1, fft_effort="FFTW_MEASURE"):
+    def __init__(self, grid, heights, E_star, comm=None, fft_threads=1, fft_effort="FFTW_MEASURE",
+                 boundary="periodic", hardness=None):
+        if boundary not in BOUNDARIES:
+            raise ParameterError("boundary", f"the boundary is one of {', '.join(BOUNDARIES)}, got '{boundary}'")
+        if hardness is not None and not (hardness > 0 and math.isfinite(hardness)):
+            raise ParameterError("hardness", f"the hardness must be positive and finite, got {hardness}")
         if not (E_star > 0 and math.isfinite(E_star)):
-            raise UserError(f"-E_star must be a positive, finite modulus, got {E_star}")
+            raise ParameterError("E_star", f"the composite modulus must be positive and finite, got {E_star}")
+        if np.shape(heights) != grid.shape:
+            raise ParameterError("heights", f"the heights have shape {np.shape(heights)}, the grid {grid.shape}")
         self.comm = comm or PETSc.COMM_WORLD
         self.mpi = self.comm.tompi4py()
         self.grid = grid
@@ -62,16 +80,27 @@ class ContactProblem:
         self.height_scale = float(np.sqrt(np.mean(heights ** 2)))
         self.pressure_scale = self.E_star * self.height_scale / grid.l1
         self.scaled_grid = Grid(grid.n0, grid.n1, grid.l0 / grid.l1, 1.0)
-        self.operator = Westergaard(self.scaled_grid, 1.0, self.comm, fft_threads, fft_effort)
-        self.local_rows = self.operator.local_rows
-        self.heights = self.operator.vec()
-        self.local(self.heights)[...] = heights[self.local_rows] / self.height_scale
-        self.pressure_surface = self.operator.vec()
-        self.operator.pressure_surface(self.heights, self.pressure_surface)
+        self.boundary = boundary
+        periodic = Westergaard(self.scaled_grid, 1.0, self.comm, fft_threads, fft_effort)
+        self.local_rows = periodic.local_rows
+        self.heights = periodic.vec()
+        periodic.local(self.heights)[...] = heights[self.local_rows] / self.height_scale
+        self.pressure_surface = periodic.vec()
+        periodic.pressure_surface(self.heights, self.pressure_surface)
+        if boundary == "periodic":
+            self.operator = periodic
+        else:
+            periodic.destroy()
+            self.operator = FreeBoundary(self.scaled_grid, 1.0, self.comm, fft_threads, fft_effort)
         local_pc = self.local(self.pressure_surface, readonly=True)
         sum_pc2, = allsum(self.mpi, [np.dot(local_pc.ravel(), local_pc.ravel())])
         self.m0p_scaled = sum_pc2 / self.n
-        self.complete_contact_pbar = float(-allmin(self.mpi, [local_pc.min()])[0])
+        # Complete contact (every node in contact) at pbar = -min(p_c): exact only on the periodic cell.
+        self.complete_contact_pbar = float(-allmin(self.mpi, [local_pc.min()])[0]) if boundary == "periodic" \
+            else math.inf
+        self.max_pressure_surface = float(-allmin(self.mpi, [-local_pc.max()])[0])
+        self.hardness = hardness
+        self.upper_bound = None if hardness is None else hardness / self.pressure_scale
         self.max_height = float(-allmin(self.mpi, [-self.local(self.heights, readonly=True).max()])[0])
         self.progress = None
 
@@ -80,6 +109,7 @@ class ContactProblem:
         return self.operator.vec()
 
     def local(self, v, readonly=False):
+        """This rank's rows of ``v`` as a ``(rows, n1)`` array view."""
         return self.operator.local(v, readonly)
 
     def gap(self, pressure, separation, out):
@@ -91,9 +121,13 @@ class ContactProblem:
     def contact_separation(self, pressure, elastic_gap):
         """The rigid separation d for which the gap has zero mean on the contact set (PK's choice).
 
-        ``elastic_gap`` is ``K p - h``, the gap at d = 0 (local array of this rank).
+        ``elastic_gap`` is ``K p - h``, the gap at d = 0 (local array of this rank). Under a hardness
+        cap the contact set is the elastic one (0 < p < H): the gap of a plastic node may be negative.
         """
-        in_contact = self.local(pressure, readonly=True) > 0
+        local = self.local(pressure, readonly=True)
+        in_contact = local > 0
+        if self.upper_bound is not None:
+            in_contact &= local < self.upper_bound
         sums = allsum(self.mpi, [np.sum(elastic_gap[in_contact]), np.count_nonzero(in_contact)])
         return -sums[0] / sums[1] if sums[1] else self.max_height
 
@@ -107,6 +141,14 @@ class ContactProblem:
     def sqrt_m0p(self):
         """rms of the pressure surface sqrt(m0^p) (2.52), pressure units, from the field p_c of (2.47)."""
         return math.sqrt(self.m0p_scaled) * self.pressure_scale
+
+    def complete_contact_exact(self, pbar):
+        """True when ``pbar`` (scaled) reaches complete contact, where p = pbar + p_c is the exact answer.
+
+        Under a hardness cap only while that answer stays below the cap everywhere.
+        """
+        below_cap = self.upper_bound is None or pbar + self.max_pressure_surface <= self.upper_bound
+        return pbar >= self.complete_contact_pbar and below_cap
 
     def scaled_pbar(self, pbar=None, pstar=None):
         """The prescribed mean pressure in scaled units, from ``pbar`` (pressure units) or ``pstar``."""
@@ -126,7 +168,8 @@ class Result:
 
     Pressures in pressure units, gaps in length units; ``pstar`` = pbar /
     sqrt(m0^p), ``gstar`` = gbar / sqrt(m0^h); ``A`` by node count (3.45),
-    ``A_corrected`` with the perimeter correction; ``rms_gap_contact`` is (3.50).
+    ``A_corrected`` with the perimeter correction; ``rms_gap_contact`` is (3.50) (over the elastic
+    contact nodes under a hardness cap); ``A_plastic`` the fraction of nodes at the cap (0 without one).
     """
 
     pbar: float
@@ -146,6 +189,7 @@ class Result:
     solver: str
     control: str
     history: np.ndarray = field(default=None, repr=False)
+    A_plastic: float = 0.0
 
     def summary(self):
         """A JSON-ready dict (no fields, no history)."""
@@ -181,14 +225,18 @@ def _next_rank_first_row(comm, rows):
 def measure(problem, pressure, gap):
     """Contact measures of a solution (scaled local arrays ``pressure``, ``gap``).
 
-    Returns a dict with A (3.45), A_corrected, gbar (3.46 with the SPEC erratum:
-    the mean over all nodes of the gap, zero in contact), the rms gap in
-    contact (3.50), all in scaled units except the area fractions.
+    Returns a dict with A (3.45), A_corrected, gbar (3.46 with the erratum of
+    docs/conventions.md: the mean over all nodes of the gap, zero in contact), the rms gap in
+    contact (3.50) and the plastic fraction A_plastic (nodes at the hardness cap), all in scaled
+    units except the area fractions.
     """
     in_contact = pressure > 0
+    plastic = np.zeros_like(in_contact) if problem.upper_bound is None else pressure >= problem.upper_bound
+    elastic = in_contact & ~plastic  # a plastic node's gap is its plastic penetration, not a residual
     sums = allsum(problem.mpi, [np.count_nonzero(in_contact), gap[~in_contact].sum(),
-                                np.dot(gap[in_contact], gap[in_contact]), pressure.sum()])
-    n_contact, gap_sum, gap2_contact, p_sum = sums
+                                np.dot(gap[elastic], gap[elastic]), pressure.sum(), np.count_nonzero(elastic),
+                                np.count_nonzero(plastic)])
+    n_contact, gap_sum, gap2_contact, p_sum, n_elastic, n_plastic = sums
     edges_x, edges_y = contact_perimeter_edges(problem, in_contact)
     grid = problem.grid
     dx, dy = grid.l1 / grid.n1, grid.l0 / grid.n0
@@ -200,6 +248,7 @@ def measure(problem, pressure, gap):
         "A": float(area),
         "A_corrected": float(max(corrected, 0.0)),
         "gbar": float(gap_sum / problem.n),
-        "rms_gap_contact": float(math.sqrt(gap2_contact / n_contact)) if n_contact else 0.0,
+        "rms_gap_contact": float(math.sqrt(gap2_contact / n_elastic)) if n_elastic else 0.0,
         "pbar": float(p_sum / problem.n),
+        "A_plastic": float(n_plastic / problem.n),
     }

@@ -26,7 +26,7 @@ import os
 import platform
 import re
 
-from .errors import UserError
+from .errors import ParameterError
 
 EFFORTS = ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE")
 EFFORT_VARIABLE = "ROUGHPETSC_FFT_EFFORT"
@@ -38,18 +38,18 @@ def planner_effort(effort):
 
     Raises
     ------
-    UserError
-        If the effort (or the override) is not an FFTW planner flag.
+    ParameterError
+        (parameter ``effort``) if the effort (or the override) is not an FFTW planner flag.
     """
     forced = os.environ.get(EFFORT_VARIABLE, "").strip()
     if forced:
         forced = forced.upper() if forced.upper().startswith("FFTW_") else "FFTW_" + forced.upper()
         if forced not in EFFORTS:
-            raise UserError(f"{EFFORT_VARIABLE}={os.environ[EFFORT_VARIABLE]}: not a planner effort "
-                            f"(one of {', '.join(EFFORTS)})")
+            raise ParameterError("effort", f"{EFFORT_VARIABLE}={os.environ[EFFORT_VARIABLE]}: not a planner "
+                                           f"effort (one of {', '.join(EFFORTS)})")
         return forced
     if effort not in EFFORTS:
-        raise UserError(f"-fft_effort: unknown planner effort '{effort}' (one of {', '.join(EFFORTS)})")
+        raise ParameterError("effort", f"unknown planner effort '{effort}' (one of {', '.join(EFFORTS)})")
     return effort
 
 

@@ -1,7 +1,8 @@
-"""Result files: JSON summaries and HDF5 files that record the options and versions that made them.
+"""Result files: checks of output paths, atomic replacement, JSON, versions and provenance.
 
 Files are written by rank 0 to a temporary name in the same folder and renamed
-at the end, so a failed or killed run leaves no half-written file.
+at the end (:class:`atomic_path`), so a failed or killed run leaves no half-written
+file. HDF5 files are written by :mod:`roughpetsc.store`.
 """
 
 import json
@@ -220,61 +221,22 @@ def _fsync(path):
         os.close(handle)
 
 
-def _jsonable(value):
+def jsonable(value):
+    """``value`` with numpy arrays and scalars as Python lists and numbers, non-finite floats as None (JSON null)."""
     if isinstance(value, dict):
-        return {k: _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
+        return {k: jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [jsonable(v) for v in value]
     if isinstance(value, np.generic):
-        return value.item()
+        value = value.item()
     if isinstance(value, float) and not np.isfinite(value):
         return None
     return value
 
 
 def write_json(path, data):
-    """Write ``data`` as indented JSON, atomically."""
+    """Write ``data`` as indented JSON, atomically (the one JSON writer of every mode)."""
     with atomic_path(path) as temporary:
         with open(temporary, "w") as f:
-            json.dump(_jsonable(data), f, indent=2)
+            json.dump(jsonable(data), f, indent=2)
             f.write("\n")
-
-
-def _attribute(value):
-    if isinstance(value, (dict, list)):
-        return json.dumps(_jsonable(value))
-    return "" if value is None else value
-
-
-def write_h5(path, summary, fields=None, histories=None, step_fields=None, attributes=None):
-    """Write an HDF5 file: attributes from the summary (nested values as JSON), datasets of fields.
-
-    ``fields`` maps names to whole arrays (e.g. heights, pressure, gap),
-    ``histories`` maps step indices to residual-history arrays,
-    ``step_fields`` maps step indices to ``{name: array}`` kept in ``steps/NNN/``,
-    ``attributes`` maps dataset names to attributes (units, description) given
-    to every dataset of that name.
-    """
-    attributes = attributes or {}
-    import h5py
-
-    with atomic_path(path) as temporary:
-        with h5py.File(temporary, "w") as f:
-            for key, value in summary.items():
-                if key == "steps":
-                    continue
-                f.attrs[key] = _attribute(value)
-            for index, step in enumerate(summary.get("steps", [])):
-                group = f.create_group(f"steps/{index:03d}")
-                for key, value in step.items():
-                    group.attrs[key] = _attribute(value)
-                if histories and index in histories:
-                    dataset = group.create_dataset("history", data=histories[index])
-                    dataset.attrs["columns"] = "iteration, natural_residual, operator_applications, seconds"
-                    dataset.attrs.update(attributes.get("history", {}))
-                for name, array in (step_fields or {}).get(index, {}).items():
-                    dataset = group.create_dataset(name, data=array, compression="gzip", compression_opts=1)
-                    dataset.attrs.update(attributes.get(name, {}))
-            for name, array in (fields or {}).items():
-                dataset = f.create_dataset(name, data=array, compression="gzip", compression_opts=1)
-                dataset.attrs.update(attributes.get(name, {}))

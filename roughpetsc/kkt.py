@@ -1,4 +1,6 @@
-"""KKT residuals of the contact problem (SPEC 2.4) and the TAO convergence test.
+"""KKT residuals of the contact problem (3.41)-(3.44) of the dissertation and the TAO convergence test.
+
+The residuals and their scaling follow docs/conventions.md ("Residuals").
 
 All residuals are scale-free: pressures are divided by the mean pressure pbar,
 gaps by the rms height sqrt(m0^h). In the scaled variables of
@@ -17,10 +19,12 @@ from petsc4py import PETSc
 class KKTReport:
     """The KKT report of one solve.
 
-    natural : ||min(p / pbar, g / sqrt(m0^h))||_inf, the natural residual.
-    complementarity : sum(p g) / (sum(p) sqrt(m0^h)).
+    natural : ||min(p / pbar, g / sqrt(m0^h))||_inf, the natural residual; with a hardness cap
+        0 <= p <= H, ||mid(p / pbar, g / sqrt(m0^h), (p - H) / pbar)||_inf, the natural residual of
+        the box (the middle value is the distance to the projection of p - g onto [0, H]).
+    complementarity : sum(p g) / (sum(p) sqrt(m0^h)) (over the nodes below the cap, with one).
     min_p : min(p) / pbar (primal feasibility, >= 0 at a solution).
-    min_g : min(g) / sqrt(m0^h) (dual feasibility, >= 0 at a solution).
+    min_g : min(g) / sqrt(m0^h) over the nodes below the cap (dual feasibility, >= 0 at a solution).
     load_error : |mean(p) - pbar| / pbar under load control, None under displacement control.
     """
 
@@ -61,18 +65,28 @@ def allmax(comm, values):
 
 
 @PETSc.Log.EventDecorator("RPKKTCheck")  # -log_view: the residual check of every iteration
-def report(comm, pressure, gap, n_total, target_pbar=None):
+def report(comm, pressure, gap, n_total, target_pbar=None, upper=None):
     """KKT report of local arrays ``pressure``, ``gap`` (scaled units, rms height 1).
 
     ``target_pbar`` is the prescribed mean pressure under load control (None
     under displacement control, where the solution's own mean is used).
+    ``upper`` is the hardness cap in the same units (None: no upper bound).
     """
     pressure, gap = pressure.ravel(), gap.ravel()
     sum_p, sum_pg = allsum(comm, [pressure.sum(), np.dot(pressure, gap)])
     mean_p = sum_p / n_total
     scale = target_pbar if target_pbar else (mean_p if mean_p > 0 else 1.0)
-    natural, = allmax(comm, [np.abs(np.minimum(pressure / scale, gap)).max(initial=0.0)])
-    min_p, min_g = allmin(comm, [pressure.min(initial=np.inf), gap.min(initial=np.inf)])
+    if upper is None:
+        residual = np.minimum(pressure / scale, gap)
+        below_cap = gap
+    else:
+        # mid(a, b, c) = max(min(a, b), min(max(a, b), c)) with a = p, b = g, c = p - H (a > c).
+        low, high = pressure / scale, (pressure - upper) / scale
+        residual = np.maximum(np.minimum(low, gap), np.minimum(np.maximum(low, gap), high))
+        below_cap = gap[pressure < upper]
+        sum_pg, = allsum(comm, [np.dot(pressure[pressure < upper], below_cap)])
+    natural, = allmax(comm, [np.abs(residual).max(initial=0.0)])
+    min_p, min_g = allmin(comm, [pressure.min(initial=np.inf), below_cap.min(initial=np.inf)])
     return KKTReport(
         natural=float(natural),
         complementarity=float(sum_pg / sum_p) if sum_p > 0 else 0.0,
@@ -158,20 +172,19 @@ class ConvergenceTest:
     improved for ``STAGNATION_ITERATIONS`` iterations (``stopped_by`` says which).
 
     ``gap_of(x)`` returns the local gap array of the iterate ``x`` (cached by
-    the objective when possible), ``pbar_of(x)`` the normalising pressure.
+    the objective when possible).
     """
 
-    def __init__(self, comm, n_total, rtol, gap_of, history, target_pbar=None, pressure_of=None, max_seconds=0.0,
-                 best=None):
+    def __init__(self, comm, n_total, rtol, gap_of, history, target_pbar=None, max_seconds=0.0, best=None,
+                 upper=None):
         self.comm = comm
+        self.upper = upper  # the hardness cap (scaled), or None
         self.n_total = n_total
         self.rtol = rtol
         self.gap_of = gap_of
         self.history = history
         self.target_pbar = target_pbar
-        self.pressure_of = pressure_of or (lambda x: x.getArray(readonly=True))
         self.max_seconds = max_seconds
-        self.last = None
         self.best_natural = np.inf
         self.best = best  # a Vec that receives the best iterate, or None
         self.since_best = 0
@@ -180,8 +193,8 @@ class ConvergenceTest:
 
     def __call__(self, tao):
         x = tao.getSolution()
-        kkt = report(self.comm, self.pressure_of(x), self.gap_of(x), self.n_total, self.target_pbar)
-        self.last = kkt
+        kkt = report(self.comm, x.getArray(readonly=True), self.gap_of(x), self.n_total, self.target_pbar,
+                     self.upper)
         iteration = tao.getIterationNumber()
         self.history.record(iteration + self.iteration_offset, kkt.natural)
         load_ok = kkt.load_error is None or kkt.load_error <= self.rtol
@@ -206,12 +219,12 @@ class ConvergenceTest:
 
 
 class CompositeCriterion:
-    """The seed's composite convergence criterion, evaluated per iteration as a TAO monitor.
+    """The dissertation's composite convergence criterion (3.47)-(3.51), evaluated per iteration as a TAO monitor.
 
     (3.47) ||p^k - p^(k-1)||_2 / ||p^k||_2 < 5e-5;
     (3.48) |A^k - A^(k-1)| / A^k < 2 / (Nx Ny);
     (3.51) sigma_h < min(1e-4 sqrt(m0^h), 0.01 gbar), sigma_h the rms gap over the contact
-           nodes as in (3.50) (the mean over them; the seed's 1/N is read as 1/|contact set|).
+           nodes as in (3.50) (the mean over them; the dissertation's 1/N is read as 1/|contact set|).
     (3.49), monotone A* and gbar along a load path, involves two solves and is
     checked by the callers that have a path (ensembles).
 

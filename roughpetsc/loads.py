@@ -1,22 +1,22 @@
-"""Load paths in p* = pbar / sqrt(m0^p): the seed's load history (7.11) and user lists.
+"""Load paths in p* = pbar / sqrt(m0^p): the load history (7.11) of the dissertation and user lists.
 
-Eq. (7.11) of the seed divides p* in (0, 4] into three stages with n1 = 30,
+Eq. (7.11) of the dissertation divides p* in (0, 4] into three stages with n1 = 30,
 n2 = 45 and n3 = 20 sub-steps::
 
     p*_i = i D1                              0 < i <= 30
     p*_i = exp(ln 0.2 + D2 (i - 30))        30 < i <= 75
     p*_i = 2 + D3 (i - 75)                  75 < i <= 95
 
-with D2 = 0.0512 and D3 = 0.1. The seed prints D1 = 0.067, which contradicts
+with D2 = 0.0512 and D3 = 0.1. The dissertation prints D1 = 0.067, which contradicts
 its own early stage (0, 0.2] with 30 steps (30 * 0.067 = 2.01); following the
-erratum of SPEC section 5 we use D1 = 0.2 / 30, so the first stage ends at
+erratum in docs/conventions.md we use D1 = 0.2 / 30, so the first stage ends at
 exactly 0.2 and joins the second.
 
 The second stage does not end at exactly 2: 0.2 exp(0.0512 * 45) =
 0.2 exp(2.304) = 2.00283..., slightly above the third stage's origin 2, so
 step 75 (2.00283) and step 76 (2.1) are 0.0972 apart instead of 0.1. The
 history is nevertheless strictly increasing and ends at p*_95 = 4. We keep
-the seed's D2 as printed (D2 = ln(10) / 45 = 0.051168... would end exactly
+the dissertation's D2 as printed (D2 = ln(10) / 45 = 0.051168... would end exactly
 at 2).
 """
 
@@ -27,7 +27,7 @@ import numpy as np
 from .errors import UserError
 
 N1, N2, N3 = 30, 45, 20
-DELTA1 = 0.2 / N1          # SPEC 5 erratum; the seed prints 0.067
+DELTA1 = 0.2 / N1          # erratum of (7.11), docs/conventions.md; the dissertation prints 0.067
 DELTA2 = 0.0512
 DELTA3 = 0.1
 

@@ -1,7 +1,12 @@
 """Our options in PETSc's options database: help text, typed reads with clear errors, unused-option check."""
 
 import ctypes
+import ctypes.util
 import difflib
+import functools
+import glob
+import os
+import warnings
 
 from petsc4py import PETSc
 
@@ -117,24 +122,77 @@ def check_names(known_names):
         raise UserError(f"unknown option -{name}{hint}; -help lists the options")
 
 
-def _petsc_library():
-    with open("/proc/self/maps") as maps:
-        for line in maps:
-            if "libpetsc" in line and ".so" in line:
-                return ctypes.CDLL(line.split()[-1])
-    return None
+def _library_candidates():
+    """Paths where the PETSc library that petsc4py uses may be: the loaded one first."""
+    try:  # Linux: the library this process has loaded
+        with open("/proc/self/maps") as maps:
+            yield from (line.split()[-1] for line in maps if "libpetsc" in line and ".so" in line)
+    except OSError:
+        pass
+    import petsc4py
+
+    config = petsc4py.get_config()  # the PETSc petsc4py was built against (macOS, BSD, Windows)
+    folder = os.path.join(config.get("PETSC_DIR", ""), config.get("PETSC_ARCH", "") or "", "lib")
+    yield from sorted(glob.glob(os.path.join(folder, "libpetsc*.*")))
+    found = ctypes.util.find_library("petsc")
+    if found:
+        yield found
+
+
+PROBE_OPTION = "roughpetsc_options_probe"
+
+
+def _is_this_database(library):
+    """True if ``library`` holds the options database petsc4py writes to (and not another copy of PETSc)."""
+    database = PETSc.Options()
+    database.setValue(PROBE_OPTION, "1")
+    try:
+        found = ctypes.c_int(0)  # PetscBool
+        if library.PetscOptionsHasName(None, None, ("-" + PROBE_OPTION).encode(), ctypes.byref(found)):
+            return False
+        return bool(found.value)
+    finally:
+        database.delValue(PROBE_OPTION)
+
+
+@functools.lru_cache(maxsize=1)
+def petsc_library():
+    """``(ctypes handle of the PETSc library in use, None)``, or ``(None, why it was not found)``.
+
+    petsc4py 3.18 does not expose PetscOptionsLeftGet (nor which options were queried), so the
+    check of unused options calls it through ctypes in the library petsc4py has loaded.
+    """
+    tried = []
+    for path in _library_candidates():
+        try:
+            library = ctypes.CDLL(path)
+        except OSError:
+            tried.append(path)
+            continue
+        if hasattr(library, "PetscOptionsLeftGet") and _is_this_database(library):
+            return library, None
+        tried.append(path)
+    return None, ("the PETSc library petsc4py uses was not found" + (f" (tried {', '.join(tried)})" if tried else "")
+                  + "; petsc4py itself cannot list the options nothing read")
 
 
 def unused_options():
-    """Names of options in the database that nothing has read so far (PetscOptionsLeftGet)."""
-    library = _petsc_library()
+    """Names of options in the database that nothing has read so far (PetscOptionsLeftGet).
+
+    None if this platform's PETSc cannot be asked; a :class:`RuntimeWarning` then says why (Python
+    shows it once).
+    """
+    library, why = petsc_library()
     if library is None:
-        return []
+        warnings.warn(f"misspelled options cannot be detected: {why}", RuntimeWarning, stacklevel=2)
+        return None
     count = ctypes.c_int32() if PETSc.IntType().itemsize == 4 else ctypes.c_int64()
     names = ctypes.POINTER(ctypes.c_char_p)()
     values = ctypes.POINTER(ctypes.c_char_p)()
     if library.PetscOptionsLeftGet(None, ctypes.byref(count), ctypes.byref(names), ctypes.byref(values)):
-        return []
+        warnings.warn("misspelled options cannot be detected: PetscOptionsLeftGet failed", RuntimeWarning,
+                      stacklevel=2)
+        return None
     left = [names[i].decode() for i in range(count.value)]
     library.PetscOptionsLeftRestore(None, ctypes.byref(count), ctypes.byref(names), ctypes.byref(values))
     return left
@@ -156,7 +214,10 @@ def check_unused(ignore=(), final=True):
     or after the solve (:func:`read_late`) are skipped, so a misspelling fails
     before the work and a late option is checked by the final call after it.
     """
-    left = [name for name in unused_options()
+    unused = unused_options()
+    if unused is None:  # cannot be checked here: unused_options has said so
+        return
+    left = [name for name in unused
             if name not in ignore and name not in FINALIZE_OPTIONS and (final or not read_late(name))]
     if left:
         raise UserError("option(s) given but not used by this run: " + ", ".join("-" + n for n in left)

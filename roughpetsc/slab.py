@@ -32,7 +32,7 @@ Two exchanges:
 
 import numpy as np
 
-from .errors import UserError
+from .errors import ParameterError
 from .fftw import planner_effort
 
 
@@ -58,13 +58,21 @@ def row_split(n0, size):
 
     Raises
     ------
-    UserError
-        If a rank would own no row (more ranks than rows).
+    ParameterError
+        (parameter ``n0``) if a rank would own no row (more ranks than rows).
     """
     if n0 < size:
-        raise UserError(f"-surface_N0/-surface_N: the grid has {n0} row(s), fewer than the {size} MPI ranks "
-                        "that share them (every rank needs at least one row)")
+        raise ParameterError("n0", f"the grid has {n0} row(s), fewer than the {size} MPI ranks "
+                                   "that share them (every rank needs at least one row)")
     return block_split(n0, size)
+
+
+def gather_rows(comm, local):
+    """The whole array on rank 0 (None elsewhere) from each rank's block of rows (mpi4py ``comm``)."""
+    if comm.Get_size() == 1:
+        return np.array(local)
+    parts = comm.gather(np.ascontiguousarray(local), root=0)
+    return np.concatenate(parts, axis=0) if comm.Get_rank() == 0 else None
 
 
 def _shares_memory(comm):
@@ -108,12 +116,12 @@ class SlabTransform:
         size, rank = comm.Get_size(), comm.Get_rank()
         row_starts, row_counts = row_split(n0, size)
         if n1 // 2 + 1 < size:
-            raise UserError(f"-surface_N: {n1} columns give {n1 // 2 + 1} spectral columns, fewer than the "
-                            f"{size} MPI ranks that share them")
+            raise ParameterError("n1", f"{n1} columns give {n1 // 2 + 1} spectral columns, fewer than the "
+                                       f"{size} MPI ranks that share them")
         if exchange == "auto":
             exchange = "shared" if _shares_memory(comm) else "alltoall"
         if exchange not in ("shared", "alltoall"):
-            raise ValueError(f"unknown exchange {exchange!r}")
+            raise ParameterError("exchange", f"unknown exchange {exchange!r} (auto, shared or alltoall)")
         self.exchange = exchange
         self.comm = comm
         self.shape = (n0, n1)
@@ -212,7 +220,7 @@ class SlabTransform:
         """``target = irfft2(symbol * rfft2(source))``, unnormalised (put 1/(n0 n1) into the symbol).
 
         ``symbol`` is real, shape ``(n0, 2 * columns)``: one value per float of the
-        local spectral block (each value twice), as for ``westergaard._SerialTransform``.
+        local spectral block (each value twice), as for ``westergaard.SerialTransform``.
         """
         spectrum = self.forward(source)
         spectrum.view(np.float64).__imul__(symbol)

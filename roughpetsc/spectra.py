@@ -1,6 +1,6 @@
-"""Spectral moments, bandwidth parameters and the pressure surface (seed ch. 2, sec. 7.2).
+"""Spectral moments, bandwidth parameters and the pressure surface (the dissertation, ch. 2 and sec. 7.2).
 
-Conventions (SPEC section 1): Fourier pair (2.1)/(2.2), wavenumbers ``k`` in
+Conventions (docs/conventions.md): Fourier pair (2.1)/(2.2), wavenumbers ``k`` in
 cycles/length, angular wavenumbers ``w = 2 pi k`` only inside moments (2.12).
 Array layout as in :mod:`roughpetsc.surfaces`: axis 0 = rows = ``y``, axis 1 = ``x``.
 
@@ -11,7 +11,7 @@ surface ``p_c`` in pressure units) along one direction:
   ``m_n0 = (n0 n1)^-2 sum_k |DFT(f)_k|^2 (2 pi k_x)^n``, ``m_0n`` with ``k_y``;
 * by finite differences (7.6)/(7.7): ``m_n0 = < (d^(n/2) f / dx^(n/2))^2 >``.
 
-The seed's "Num" columns (Tables 7.2-7.6, 8.2, 8.3) are the finite-difference
+The dissertation's "Num" columns (Tables 7.2-7.6, 8.2, 8.3) are the finite-difference
 moments with the stencils of :data:`SEED_STENCILS` (see :func:`fd_derivative`);
 the moment of a direction-free quantity (the ``m_n`` of an isotropic surface)
 is the mean of the x and y moments (sec. 7.2.2).
@@ -21,13 +21,16 @@ from math import prod
 
 import numpy as np
 
+from .errors import ParameterError
+
 MOMENT_ORDERS = (0, 2, 4, 6)
 AXES = {"x": 1, "y": 0}
 
 # Finite-difference schemes for the derivative of order 1, 2, 3 along one axis.
-# "seed": central first derivative, three-point second derivative, and the
-# third derivative as the central difference of the three-point second
-# derivative; this is the scheme that reproduces the seed's tables.
+# "seed" (the name the option -stats_fd_scheme has always taken): central first
+# derivative, three-point second derivative, and the third derivative as the
+# central difference of the three-point second derivative; this is the scheme
+# that reproduces the dissertation's tables.
 # "central": the central difference applied repeatedly (the literal reading of
 # "central differentiation of the derivative of order n - 1" in sec. 7.2.1).
 SEED_STENCILS = "seed"
@@ -136,9 +139,9 @@ def fd_derivative(field, spacing, axis, order, scheme=SEED_STENCILS):
     ndarray, same shape: [field] / length^order.
     """
     if scheme not in FD_SCHEMES:
-        raise ValueError(f"unknown finite-difference scheme {scheme!r}; use one of {FD_SCHEMES}")
+        raise ParameterError("scheme", f"unknown finite-difference scheme {scheme!r}; use one of {FD_SCHEMES}")
     if order not in (1, 2, 3):
-        raise ValueError(f"derivative order must be 1, 2 or 3, got {order}")
+        raise ParameterError("order", f"the derivative order must be 1, 2 or 3, got {order}")
 
     def central(f):
         return (np.roll(f, -1, axis) - np.roll(f, 1, axis)) / (2.0 * spacing)
@@ -230,7 +233,7 @@ def pressure_bandwidth_from_heights(m2h, m4h, m6h):
 def isotropy_factor(n):
     """``1*3*...*(n-1) / (2*4*...*n)`` of (2.15); 1 for n = 0."""
     if n % 2:
-        raise ValueError(f"moment order must be even, got {n}")
+        raise ParameterError("n", f"the moment order must be even, got {n}")
     half = n // 2
     return prod(2 * j - 1 for j in range(1, half + 1)) / prod(2 * j for j in range(1, half + 1))
 
@@ -327,7 +330,8 @@ def pressure_surface(grid, heights, e_star=1.0):
     Returns
     -------
     ndarray, shape grid.shape: p_c [pressure], zero mean. The "pressure surface"
-    of the seed is ``-p_c``.
+    of the dissertation is ``-p_c``. The solver applies the same symbol
+    distributed over the ranks (:meth:`roughpetsc.westergaard.Westergaard.pressure_surface`).
     """
     k0, k1 = grid.rfft_wavenumbers()
     spectrum = np.fft.rfft2(heights)
@@ -349,7 +353,7 @@ def surface_moment_summary(grid, heights, e_star=1.0, scheme=SEED_STENCILS):
     (finite differences (7.6)/(7.7) and spectrum (2.12));
     ``"p_fd"``, ``"p_spectral"``: the same for p_c (2.47), n = 0, 2, 4;
     ``"alpha_h"``, ``"alpha_p"``: (2.16)/(2.54) from the isotropic means of the
-    finite-difference moments (the seed's "Num");
+    finite-difference moments (the dissertation's "Num");
     ``"alpha_h_spectral"``, ``"alpha_p_spectral"``: the same from the spectrum;
     ``"alpha_p_from_h"``: 27/20 m2 m6 / m4^2 (2.54) with the spectral m^h.
     """

@@ -2,8 +2,11 @@
 
 Array layout: a surface is a real array of shape ``(n0, n1)``; axis 0 ("rows",
 ``y``) is the one distributed over MPI ranks, axis 1 (``x``) is contiguous.
-Heights are returned with zero mean (SPEC section 1). Wavenumbers are in cycles
-per length, as in the Fourier pair (2.1)/(2.2) of the seed.
+Heights are returned with zero mean (docs/conventions.md). Wavenumbers are in
+cycles per length, as in the Fourier pair (2.1)/(2.2) of the dissertation.
+
+Bad values raise :class:`~roughpetsc.errors.ParameterError` naming the Python
+parameter; the command line names the option (``roughpetsc.cli``).
 """
 
 from dataclasses import dataclass
@@ -12,7 +15,7 @@ import os
 
 import numpy as np
 
-from .errors import UserError
+from .errors import ParameterError
 
 
 @dataclass(frozen=True)
@@ -54,7 +57,12 @@ class Grid:
 
 
 def fractal_amplitude(k_l, k_s, hurst, m2):
-    """PSD amplitude C of (2.18) with k_r = k_l from a prescribed m2^h, eq. (7.1)."""
+    """PSD amplitude C of (2.18) with k_r = k_l from a prescribed m2^h, eq. (7.1).
+
+    ``C = 4 (1 - H) m2 / ((2 pi)^3 (k_s^(2-2H) - k_l^(2-2H)))`` [length^(4-2H)] with ``k_l``,
+    ``k_s`` in cycles/length and ``m2`` dimensionless. The one source of C: the models call it
+    ``psd_amplitude`` (:mod:`roughpetsc.models.persson`).
+    """
     return 4.0 * (1.0 - hurst) * m2 / ((2.0 * np.pi) ** 3 * (k_s ** (2 - 2 * hurst) - k_l ** (2 - 2 * hurst)))
 
 
@@ -68,18 +76,18 @@ def fractal_psd(k, k_l, k_s, hurst, amplitude):
 
 
 def check_fractal_parameters(grid, k_l, k_s, hurst, m2):
-    """Raise :class:`UserError` naming the option for an impossible PSD."""
+    """Raise :class:`ParameterError` for a PSD (2.18) that the grid cannot hold or that does not exist."""
     nyquist = min(grid.n0 / grid.l0, grid.n1 / grid.l1) / 2.0
     if not 0.0 < hurst < 1.0:
-        raise UserError(f"-surface_H must lie in (0, 1), got {hurst}")
+        raise ParameterError("hurst", f"the Hurst exponent must lie in (0, 1), got {hurst}")
     if not m2 > 0.0:
-        raise UserError(f"-surface_m2 must be positive, got {m2}")
+        raise ParameterError("m2", f"the mean square slope m2 must be positive, got {m2}")
     if not 0.0 < k_l < k_s:
-        raise UserError(f"need 0 < -surface_kl < -surface_ks, got kl={k_l}, ks={k_s}")
+        raise ParameterError("k_l", f"need 0 < k_l < k_s for the cut-off wavenumbers, got k_l={k_l}, k_s={k_s}")
     if k_s > nyquist:
-        raise UserError(f"-surface_ks={k_s} exceeds the Nyquist wavenumber {nyquist} of the grid")
+        raise ParameterError("k_s", f"the cut-off k_s={k_s} exceeds the Nyquist wavenumber {nyquist} of the grid")
     if k_l < 1.0 / max(grid.l0, grid.l1):
-        raise UserError(f"-surface_kl={k_l} is below the fundamental wavenumber of the cell")
+        raise ParameterError("k_l", f"the cut-off k_l={k_l} is below the fundamental wavenumber of the cell")
 
 
 def fractal(grid, k_l, k_s, hurst, m2, seed):
@@ -108,8 +116,17 @@ def fractal(grid, k_l, k_s, hurst, m2, seed):
     return np.fft.irfft2(spectrum, s=grid.shape)
 
 
+def check_waviness(amplitude, *wavelengths):
+    """Raise :class:`ParameterError` unless the amplitude and the wavelengths (length units) are positive."""
+    if not amplitude > 0:
+        raise ParameterError("amplitude", f"the amplitude must be positive, got {amplitude}")
+    if not all(wavelength > 0 for wavelength in wavelengths):
+        raise ParameterError("wavelength", f"the wavelength must be positive, got {', '.join(map(str, wavelengths))}")
+
+
 def bisinusoid(grid, amplitude, wavelength0, wavelength1):
-    """Bisinusoidal waviness (3.52): Delta cos(2 pi y / lambda_y) cos(2 pi x / lambda_x)."""
+    """Bisinusoidal waviness (3.52): Delta cos(2 pi y / lambda_y) cos(2 pi x / lambda_x), length units."""
+    check_waviness(amplitude, wavelength0, wavelength1)
     y, x = grid.coordinates()
     return amplitude * np.cos(2 * np.pi * y / wavelength0) * np.cos(2 * np.pi * x / wavelength1)
 
@@ -121,12 +138,15 @@ def wave(grid, amplitude, wavelength):
     ``-h cos(2 pi x / lambda)`` with ``h`` = ``amplitude``. Its complete-contact
     pressure is ``p_star = pi E* h / lambda`` (Johnson, Contact Mechanics, 13.2).
     """
+    check_waviness(amplitude, wavelength)
     _, x = grid.coordinates()
     return np.broadcast_to(-amplitude * np.cos(2 * np.pi * x / wavelength), grid.shape).copy()
 
 
 def hertz_sphere(grid, radius):
     """A paraboloid cap ``-r^2 / (2 R)`` centred in the cell, zero mean (a sphere in a large cell)."""
+    if not radius > 0:
+        raise ParameterError("radius", f"the radius of the sphere must be positive, got {radius}")
     y, x = grid.coordinates()
     r2 = (y - grid.l0 / 2) ** 2 + (x - grid.l1 / 2) ** 2
     heights = -r2 / (2.0 * radius)
@@ -147,61 +167,78 @@ def load(path):
         The recorded cell length along axis 1 (x), length units; None if the
         file does not record one.
 
-    Raises :class:`UserError` naming the file if it is missing, unreadable or
-    not a finite 2-D array.
+    Raises :class:`ParameterError` (parameter ``path``) naming the file if it
+    is missing, unreadable or not a finite 2-D array.
     """
-    length = None
     if not os.path.isfile(path):
-        raise UserError(f"-surface_file: no such file: {path}")
-    suffix = os.path.splitext(path)[1].lower()
+        raise ParameterError("path", f"no such file: {path}")
     try:
-        if suffix == ".npy":
-            heights = np.load(path, allow_pickle=False)
-        elif suffix in (".h5", ".hdf5", ".hdf"):
-            import h5py
-
-            with h5py.File(path, "r") as f:
-                if "surface" in f:
-                    heights = f["surface"][()]
-                elif "heights" in f:
-                    heights = f["heights"][()]
-                    if "length" in f.attrs:
-                        length = float(json.loads(f.attrs["length"])[1])
-                else:
-                    raise UserError(f"-surface_file {path}: no dataset 'surface' or 'heights' in the HDF5 file")
-        else:
-            heights = np.loadtxt(path, ndmin=2)
-    except UserError:
+        heights, length = _read_array(path)
+    except ParameterError:
         raise
     except Exception as exc:  # any reader failure is the file's fault
-        raise UserError(f"-surface_file {path}: cannot read it ({type(exc).__name__}: {exc})") from None
-    return validate(heights, f"-surface_file {path}"), length
+        raise ParameterError("path", f"{path}: cannot read it ({type(exc).__name__}: {exc})") from None
+    try:
+        return validate(heights), length
+    except ParameterError as error:
+        raise ParameterError("path", f"{path}: {error}") from None
 
 
-def validate(heights, source):
+def _read_array(path):
+    """``(heights as stored, recorded length or None)`` of a surface file, by its suffix."""
+    suffix = os.path.splitext(path)[1].lower()
+    if suffix == ".npy":
+        return np.load(path, allow_pickle=False), None
+    if suffix not in (".h5", ".hdf5", ".hdf"):
+        return np.loadtxt(path, ndmin=2), None
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        if "surface" in f:
+            return f["surface"][()], None
+        if "heights" in f:
+            length = float(json.loads(f.attrs["length"])[1]) if "length" in f.attrs else None
+            return f["heights"][()], length
+    raise ParameterError("path", f"{path}: no dataset 'surface' or 'heights' in the HDF5 file")
+
+
+def validate(heights):
     """Check a height array and return it as float64 with zero mean.
 
-    ``source`` names the option or file in the error message.
+    Raises :class:`ParameterError` (parameter ``heights``) for anything but a
+    finite, real, non-flat 2-D array of at least 2x2 nodes.
     """
     heights = np.asarray(heights)
     if heights.ndim != 2 or min(heights.shape) < 2:
-        raise UserError(f"{source}: a surface must be a 2-D array with at least 2x2 nodes, got shape {heights.shape}")
+        raise ParameterError("heights", "a surface must be a 2-D array with at least 2x2 nodes, "
+                                        f"got shape {heights.shape}")
     if not np.issubdtype(heights.dtype, np.number) or np.iscomplexobj(heights):
-        raise UserError(f"{source}: heights must be real numbers, got dtype {heights.dtype}")
+        raise ParameterError("heights", f"heights must be real numbers, got dtype {heights.dtype}")
     heights = heights.astype(np.float64)
     bad = ~np.isfinite(heights)
     if bad.any():
-        raise UserError(f"{source}: {int(bad.sum())} height(s) are NaN or Inf")
+        raise ParameterError("heights", f"{int(bad.sum())} height(s) are NaN or Inf")
     heights = heights - heights.mean()
     # A second pass removes the rounding left by a large offset (heights offset by 1e6 rms).
     heights -= heights.mean()
     if not np.any(heights):
-        raise UserError(f"{source}: the surface is flat (all heights equal)")
+        raise ParameterError("heights", "the surface is flat (all heights equal)")
     return heights
+
+
+def square_grid(n1, n0=0, length=1.0):
+    """The :class:`Grid` of ``n0 x n1`` square nodes (``n0 = 0``: ``n1``) and cell length ``length`` along x."""
+    n0 = n0 or n1
+    if n1 < 2 or n0 < 1:
+        raise ParameterError("n1", f"the grid needs at least 2 columns and 1 row, got {n0} x {n1} nodes")
+    if not (length > 0 and np.isfinite(length)):
+        raise ParameterError("length", f"the cell length must be positive and finite, got {length}")
+    return Grid(n0, n1, length * n0 / n1, length)
 
 
 # Options of the surface, with defaults: the embedded default is a surface of
 # group #1 of Table 7.1, (k_l, k_s, H) = (16, 64, 0.8), m2 = 2e-4, N = 256.
+# The one place of these defaults: from_options, parameters and roughpetsc.presets read them here.
 SURFACE_OPTIONS = [
     ("surface_type", "fractal", "fractal | bisinusoid | wave | sphere (an error with -surface_file)"),
     ("surface_file", "", "read heights from PATH (.npy, a text matrix, .h5/.hdf5 dataset 'surface', or a "
@@ -228,33 +265,36 @@ TYPE_OPTIONS = {
     "sphere": ("surface_radius",),
 }
 
+# The keyword of :func:`fractal` that each fractal option sets.
+FRACTAL_KEYWORDS = {"surface_kl": "k_l", "surface_ks": "k_s", "surface_H": "hurst", "surface_m2": "m2",
+                    "surface_seed": "seed"}
+
+
+def option_values(opts, names):
+    """``{name: value}`` of the surface options ``names``, read with the type and default of :data:`SURFACE_OPTIONS`.
+
+    ``opts`` is a ``petsc4py.PETSc.Options`` (or anything with its ``get*`` methods).
+    """
+    defaults = {name: default for name, default, _ in SURFACE_OPTIONS}
+    read = {int: opts.getInt, float: opts.getReal, str: opts.getString}
+    return {name: read[type(defaults[name])](name, defaults[name]) for name in names}
+
 
 def parameters(opts):
     """The surface's parameters as used, defaults included: ``{option name: value}`` (for output files).
 
     A surface read from a file is recorded by its path and -surface_L.
     """
-    defaults = {name: default for name, default, _ in SURFACE_OPTIONS}
-    path = opts.getString("surface_file", "")
-    if path:
-        names = ("surface_file", "surface_L")
-    else:
-        kind = opts.getString("surface_type", "fractal")
-        names = ("surface_type", "surface_N", "surface_N0", "surface_L") + TYPE_OPTIONS.get(kind, ())
-    read = {int: opts.getInt, float: opts.getReal, str: opts.getString}
-    return {name: read[type(defaults[name])](name, defaults[name]) for name in names}
+    if opts.getString("surface_file", ""):
+        return option_values(opts, ("surface_file", "surface_L"))
+    kind = opts.getString("surface_type", "fractal")
+    return option_values(opts, ("surface_type", "surface_N", "surface_N0", "surface_L") + TYPE_OPTIONS.get(kind, ()))
 
 
 def grid_from_options(opts):
     """The :class:`Grid` named by ``-surface_N``, ``-surface_N0`` and ``-surface_L``."""
-    n1 = opts.getInt("surface_N", 256)
-    n0 = opts.getInt("surface_N0", 0) or n1
-    length = opts.getReal("surface_L", 1.0)
-    if n1 < 2 or n0 < 1:
-        raise UserError(f"-surface_N must be at least 2 (and -surface_N0 at least 1), got N={n1}, N0={n0}")
-    if not (length > 0 and np.isfinite(length)):
-        raise UserError(f"-surface_L must be a positive length, got {length}")
-    return Grid(n0, n1, length * n0 / n1, length)
+    given = option_values(opts, ("surface_N", "surface_N0", "surface_L"))
+    return square_grid(given["surface_N"], given["surface_N0"], given["surface_L"])
 
 
 def from_options(opts, seed=None):
@@ -270,30 +310,20 @@ def from_options(opts, seed=None):
         heights, recorded_length = load(path)
         # An explicit -surface_L wins over the length a roughpetsc file records.
         length = opts.getReal("surface_L", recorded_length or 1.0)
-        if not (length > 0 and np.isfinite(length)):
-            raise UserError(f"-surface_L must be a positive length, got {length}")
         n0, n1 = heights.shape
-        return Grid(n0, n1, length * n0 / n1, length), heights
+        return square_grid(n1, n0, length), heights
     grid = grid_from_options(opts)
     kind = opts.getString("surface_type", "fractal")
+    if kind not in TYPE_OPTIONS:
+        raise ParameterError("kind", f"unknown surface type '{kind}' (fractal, bisinusoid, wave, sphere)")
+    given = option_values(opts, TYPE_OPTIONS[kind])
     if kind == "fractal":
-        seed = opts.getInt("surface_seed", 1) if seed is None else seed
-        heights = fractal(grid, opts.getReal("surface_kl", 16.0), opts.getReal("surface_ks", 64.0),
-                          opts.getReal("surface_H", 0.8), opts.getReal("surface_m2", 2e-4), seed)
-    elif kind in ("bisinusoid", "wave"):
-        amplitude = opts.getReal("surface_amplitude", 0.01)
-        wavelength = opts.getReal("surface_wavelength", 0.0) or grid.l1
-        if not (amplitude > 0 and wavelength > 0):
-            raise UserError("-surface_amplitude and -surface_wavelength must be positive")
-        if kind == "wave":
-            heights = wave(grid, amplitude, wavelength)
-        else:
-            heights = bisinusoid(grid, amplitude, wavelength * grid.l0 / grid.l1, wavelength)
+        keywords = {FRACTAL_KEYWORDS[name]: value for name, value in given.items()}
+        heights = fractal(grid, **dict(keywords, seed=keywords["seed"] if seed is None else seed))
     elif kind == "sphere":
-        radius = opts.getReal("surface_radius", 10.0)
-        if not radius > 0:
-            raise UserError(f"-surface_radius must be positive, got {radius}")
-        heights = hertz_sphere(grid, radius)
+        heights = hertz_sphere(grid, given["surface_radius"])
     else:
-        raise UserError(f"-surface_type: unknown type '{kind}' (fractal, bisinusoid, wave, sphere)")
-    return grid, validate(heights, f"-surface_type {kind}")
+        amplitude, wavelength = given["surface_amplitude"], given["surface_wavelength"] or grid.l1
+        heights = wave(grid, amplitude, wavelength) if kind == "wave" else \
+            bisinusoid(grid, amplitude, wavelength * grid.l0 / grid.l1, wavelength)
+    return grid, validate(heights)

@@ -1,8 +1,8 @@
 """The periodic Westergaard operator (3.33) as a matrix-free PETSc shell Mat.
 
 ``w = F^-1[ F[p] / (pi E* |k|) ]`` for k != 0; the k = 0 mode carries no
-displacement (the mean pressure only moves the body rigidly, SPEC 1), so the
-mean of ``w`` is zero and the mean gap equals the rigid separation (3.38).
+displacement (the mean pressure only moves the body rigidly; docs/conventions.md),
+so the mean of ``w`` is zero and the mean gap equals the rigid separation (3.38).
 
 One rank: a direct 2-D FFTW plan (pyFFTW, r2c and c2r, built once with
 ``FFTW_MEASURE``) that reads the input Vec's memory and writes the output Vec's
@@ -10,26 +10,27 @@ memory in place: one r2c, one pointwise product, one c2r per application and no
 N^2 copy. Several ranks: the slab transform of :mod:`roughpetsc.slab` (rows of
 the real array distributed like PETSc's ownership ranges; on one node the half
 spectrum lives in an MPI-3 shared window, so there is no transpose copy). It
-replaced mpi4py-fft's PFFT (``_SlabTransform``, kept for comparison), which
-was 3.5x slower on 2 ranks here (studies/output/mpi_speedup.md).
+replaced mpi4py-fft's PFFT, which was 3.5x slower on 2 ranks here
+(studies/output/mpi_speedup.md; the study builds that PFFT pair itself).
 """
 
 import numpy as np
 from petsc4py import PETSc
 
 from .fftw import planner_effort
+from .spectra import rfft_multiplicity
 
 # PETSc log events (-log_view, prefix RP for roughpetsc): the operator applications by kind
 # (RPCompliance, RPStiffness), and every FFT pair (r2c, symbol product, c2r) whatever asked for it.
 log_event = PETSc.Log.EventDecorator
 
 
-def _wavenumber_modulus(grid, rows=slice(None), cols=slice(None)):
+def wavenumber_modulus(grid, rows=slice(None), cols=slice(None)):
     k0, k1 = grid.rfft_wavenumbers(rows)
     return np.hypot(k0, k1[:, cols])
 
 
-class _SerialTransform:
+class SerialTransform:
     """2-D real FFT pair on one rank through pyFFTW plans made once."""
 
     def __init__(self, grid, threads, effort):
@@ -73,45 +74,15 @@ class _SerialTransform:
             target[...] = self.real
 
 
-class _SlabTransform:
-    """2-D real FFT pair over MPI ranks (mpi4py-fft slab decomposition along axis 0)."""
+class FilterOperator:
+    """A compliance applied as a real Fourier filter: the Vec layout, the shell Mat, the counts.
 
-    def __init__(self, grid, comm, effort):
-        from mpi4py_fft import PFFT, newDistArray
-
-        self._fft = PFFT(comm, grid.shape, axes=(0, 1), dtype=float, grid=(-1,),
-                         backend="pyfftw", planner_effort=effort)
-        self.real = newDistArray(self._fft, False)
-        self.spectrum = newDistArray(self._fft, True)
-        self.local_rows = self._fft.local_slice(False)[0]
-        self.spectral_slice = self._fft.local_slice(True)
-
-    def filter(self, source, target, symbol):
-        self.real[...] = source
-        self._fft.forward(self.real, self.spectrum, normalize=False)
-        self.spectrum.view(np.float64).__imul__(symbol)
-        self._fft.backward(self.spectrum, self.real, normalize=False)
-        target[...] = self.real
-
-    def destroy(self):
-        self._fft.destroy()
-
-
-class Westergaard:
-    """Compliance of the periodic half-space, (3.33), applied through FFTW.
-
-    Parameters
-    ----------
-    grid : surfaces.Grid
-        The periodic cell.
-    E_star : float
-        Composite modulus E* (1.6) in pressure units.
-    comm : petsc4py.PETSc.Comm
-        Communicator; on one rank a direct 2-D FFTW plan is used.
-    threads : int
-        FFTW threads of the one-rank plan.
-    effort : str
-        FFTW planner flag (``FFTW_ESTIMATE``, ``FFTW_MEASURE``, ``FFTW_PATIENT``).
+    What the periodic (:class:`Westergaard`) and the free-boundary
+    (:class:`roughpetsc.love.FreeBoundary`) compliances share. A subclass sets ``transform`` (an
+    object with ``filter(source, target, symbol)``, ``local_rows`` and ``spectral_slice``), the
+    symbols ``compliance_symbol`` and ``preconditioner_symbol`` (real, one value per float of the
+    local spectral block, normalisation folded in) and the ``diagonal`` of the compliance matrix,
+    then calls :meth:`_set_layout`.
 
     Attributes
     ----------
@@ -121,47 +92,12 @@ class Westergaard:
         Number of FFT pairs so far (compliance or stiffness applications).
     """
 
-    def __init__(self, grid, E_star, comm=None, threads=1, effort="FFTW_MEASURE"):
-        comm = comm or PETSc.COMM_WORLD
-        size = comm.getSize()
+    def _set_layout(self, grid, comm):
         self.grid = grid
-        self.E_star = float(E_star)
         self.comm = comm
-        if size == 1:
-            self._transform = _SerialTransform(grid, threads, effort)
-        else:
-            from .slab import SlabTransform
-
-            self._transform = SlabTransform(grid, comm.tompi4py(), effort)
-        self.local_rows = self._transform.local_rows
+        self.local_rows = self.transform.local_rows
         self.local_shape = (self.local_rows.stop - self.local_rows.start, grid.n1)
-        k = _wavenumber_modulus(grid, *self._transform.spectral_slice)
-        with np.errstate(divide="ignore"):
-            # The 1/(n0 n1) of the unnormalised FFT pair is folded into the symbols.
-            compliance = np.where(k > 0, 1.0 / (np.pi * self.E_star * k), 0.0) / grid.size
-        stiffness = np.pi * self.E_star * k / grid.size
-        # The preconditioner keeps the mean: its k = 0 mode gets the symbol of the longest wavelength.
-        longest = 1.0 / max(grid.l0, grid.l1)
-        preconditioner = np.pi * self.E_star * np.maximum(k, longest) / grid.size
-        # One value per float of the complex spectrum: see _SerialTransform.filter.
-        self._compliance = np.repeat(compliance, 2, axis=1)
-        self._stiffness = np.repeat(stiffness, 2, axis=1)
-        self._preconditioner = np.repeat(preconditioner, 2, axis=1)
         self.applications = 0
-
-    @property
-    def diagonal(self):
-        """The (constant) diagonal of the compliance matrix: mean of its symbol."""
-        n0, n1 = self.grid.shape
-        k = _wavenumber_modulus(self.grid)
-        with np.errstate(divide="ignore"):
-            symbol = np.where(k > 0, 1.0 / (np.pi * self.E_star * k), 0.0)
-        # rfft layout: the columns 1..n1/2 (exclusive of Nyquist for even n1) stand for two modes.
-        weights = np.full(n1 // 2 + 1, 2.0)
-        weights[0] = 1.0
-        if n1 % 2 == 0:
-            weights[-1] = 1.0
-        return float((symbol * weights).sum() / (n0 * n1))
 
     def vec(self):
         """A new distributed Vec laid out like the grid (rows owned by this rank).
@@ -185,29 +121,22 @@ class Westergaard:
 
     @log_event("RPCompliance")
     def displacement(self, pressure, out):
-        """``out = K pressure``: surface displacement (3.33), zero mean, length units."""
+        """``out = K pressure``: the surface displacement, length units."""
         self.applications += 1
-        self._filter(self.local(pressure, readonly=True), self.local(out), self._compliance)
+        self._filter(self.local(pressure, readonly=True), self.local(out), self.compliance_symbol)
 
     @log_event("RPFFTPair")
     def _filter(self, source, target, symbol):
-        self._transform.filter(source, target, symbol)
-
-    def pressure_surface(self, heights, out):
-        """``out = F^-1[pi E* |k| F[heights]]``: the complete-contact pressure p_c of (2.47)."""
-        self._filter(self.local(heights, readonly=True), self.local(out), self._stiffness)
+        self.transform.filter(source, target, symbol)
 
     @log_event("RPStiffness")
     def stiffness(self, source, target):
-        """``target = F^-1[pi E* max(|k|, 1/L) F[source]]`` on local ``(rows, n1)`` arrays.
+        """``target = S source`` on local ``(rows, n1)`` arrays: the preconditioner's approximate inverse of K.
 
-        The inverse symbol of the compliance, with the mean (k = 0) mode
-        weighted like the longest wavelength 1/L instead of dropped: the
-        preconditioner of :mod:`roughpetsc.pk`, which needs the mean under
-        displacement control. Counts as an application.
+        Counts as an application. See the subclass for what ``S`` is.
         """
         self.applications += 1
-        self._filter(source, target, self._preconditioner)
+        self._filter(source, target, self.preconditioner_symbol)
 
     def mat(self):
         """The compliance as a symmetric shell Mat (``MATPYTHON``); destroy it when done."""
@@ -219,12 +148,78 @@ class Westergaard:
         return mat
 
     def destroy(self):
-        if hasattr(self._transform, "destroy"):
-            self._transform.destroy()
+        if hasattr(self.transform, "destroy"):
+            self.transform.destroy()
+
+
+def per_float(symbol):
+    """A real symbol repeated once per float of the complex spectrum (see :meth:`SerialTransform.filter`)."""
+    return np.repeat(symbol, 2, axis=1)
+
+
+class Westergaard(FilterOperator):
+    """Compliance of the periodic half-space, (3.33), applied through FFTW.
+
+    Parameters
+    ----------
+    grid : surfaces.Grid
+        The periodic cell.
+    E_star : float
+        Composite modulus E* (1.6) in pressure units.
+    comm : petsc4py.PETSc.Comm
+        Communicator; on one rank a direct 2-D FFTW plan is used.
+    threads : int
+        FFTW threads of the one-rank plan.
+    effort : str
+        FFTW planner flag (``FFTW_ESTIMATE``, ``FFTW_MEASURE``, ``FFTW_PATIENT``).
+
+    Attributes
+    ----------
+    transform : SerialTransform or roughpetsc.slab.SlabTransform
+        The FFT pair: a 2-D FFTW plan on one rank, the slab transform on several.
+
+    The preconditioner's ``stiffness`` is ``F^-1[pi E* max(|k|, 1/L) F[source]]``: the inverse symbol
+    of the compliance, with the mean (k = 0) mode weighted like the longest wavelength 1/L instead of
+    dropped (Polonsky-Keer needs the mean under displacement control).
+    """
+
+    def __init__(self, grid, E_star, comm=None, threads=1, effort="FFTW_MEASURE"):
+        comm = comm or PETSc.COMM_WORLD
+        self.E_star = float(E_star)
+        if comm.getSize() == 1:
+            self.transform = SerialTransform(grid, threads, effort)
+        else:
+            from .slab import SlabTransform
+
+            self.transform = SlabTransform(grid, comm.tompi4py(), effort)
+        self._set_layout(grid, comm)
+        k = wavenumber_modulus(grid, *self.transform.spectral_slice)
+        with np.errstate(divide="ignore"):
+            # The 1/(n0 n1) of the unnormalised FFT pair is folded into the symbols.
+            compliance = np.where(k > 0, 1.0 / (np.pi * self.E_star * k), 0.0) / grid.size
+        stiffness = np.pi * self.E_star * k / grid.size
+        longest = 1.0 / max(grid.l0, grid.l1)
+        preconditioner = np.pi * self.E_star * np.maximum(k, longest) / grid.size
+        self.compliance_symbol = per_float(compliance)
+        self._stiffness = per_float(stiffness)
+        self.preconditioner_symbol = per_float(preconditioner)
+
+    @property
+    def diagonal(self):
+        """The (constant) diagonal of the compliance matrix: mean of its symbol over the full spectrum."""
+        k = wavenumber_modulus(self.grid)
+        with np.errstate(divide="ignore"):
+            symbol = np.where(k > 0, 1.0 / (np.pi * self.E_star * k), 0.0)
+        # rfft layout: a column that stands for two modes of the full spectrum counts twice.
+        return float((symbol * rfft_multiplicity(self.grid.n1)).sum() / self.grid.size)
+
+    def pressure_surface(self, heights, out):
+        """``out = F^-1[pi E* |k| F[heights]]``: the complete-contact pressure p_c of (2.47)."""
+        self._filter(self.local(heights, readonly=True), self.local(out), self._stiffness)
 
 
 class _ShellContext:
-    """The MATPYTHON context of :meth:`Westergaard.mat`: K + perturbation I.
+    """The MATPYTHON context of :meth:`FilterOperator.mat`: K + perturbation I.
 
     ``perturbation`` is TAO's Hessian shift: the BNK family (BNLS, BNTR, BNTL)
     calls MatShift when a Newton step fails to descend, and expects the next

@@ -20,10 +20,7 @@ import numpy as np  # noqa: E402
 import pyfftw  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
-from roughpetsc.contact import ContactProblem  # noqa: E402
-from roughpetsc.control import Solver  # noqa: E402
-from roughpetsc.surfaces import Grid, fractal  # noqa: E402
-from roughpetsc.westergaard import Westergaard  # noqa: E402
+from roughpetsc import ContactProblem, Grid, Solver, Westergaard, fractal, fractal_group  # noqa: E402
 
 
 def median_time(function, repeats):
@@ -65,7 +62,9 @@ def operator_ratio(n, repeats):
 
 def solve_figure(n):
     grid = Grid(n, n)
-    problem = ContactProblem(grid, fractal(grid, 16, 64, 0.8, 2e-4, 1), 1.0, PETSc.COMM_SELF)
+    group = fractal_group(1)
+    heights = fractal(grid, group["k_l"], group["k_s"], group["hurst"], group["m2"], 1)
+    problem = ContactProblem(grid, heights, 1.0, PETSc.COMM_SELF)
     solver = Solver(problem, "load", None, 1e-8)
     result = solver.solve(pstar=0.5)
     solver.destroy()

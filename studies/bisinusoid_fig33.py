@@ -19,9 +19,7 @@ petsc4py.init([sys.argv[0]])
 import numpy as np  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
-from roughpetsc.contact import ContactProblem  # noqa: E402
-from roughpetsc.control import Solver  # noqa: E402
-from roughpetsc.surfaces import Grid, bisinusoid  # noqa: E402
+from roughpetsc import ContactProblem, Grid, Solver, bisinusoid  # noqa: E402
 
 E_STAR, DELTA = 220.0, 0.02
 

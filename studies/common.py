@@ -1,17 +1,21 @@
 """What the solver studies share: the test surface, the presets of solvers/, one timed solve.
 
 Import after ``petsc4py.init`` (``init()`` does it). Every study script runs
-with the project's Python: ``.venv/bin/python studies/<script>.py``.
+with the project's Python, where roughpetsc is installed (editable):
+``.venv/bin/python studies/<script>.py``. Studies use public names only: the
+API of ``roughpetsc`` (its ``__all__``) first, a module's own public names
+(``roughpetsc.kkt.report``, ...) for what the API does not export.
 """
 
-import glob
+import contextlib
 import os
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from roughpetsc import presets as preset_files
+
+ROOT = preset_files.ROOT
 OUTPUT = os.path.join(ROOT, "studies", "output")
-sys.path.insert(0, ROOT)
 
 
 def init():
@@ -20,34 +24,27 @@ def init():
     petsc4py.init([sys.argv[0]])
 
 
+def group1_heights(grid, seed=1):
+    """A surface of group #1 of Table 7.1 (options/group01.opts: (k_l, k_s, H) = (16, 64, 0.8), m2 = 2e-4)."""
+    from roughpetsc import fractal, fractal_group
+
+    group = fractal_group(1)
+    return fractal(grid, group["k_l"], group["k_s"], group["hurst"], group["m2"], seed)
+
+
 def group1_problem(n, seed=1, comm=None, effort="FFTW_MEASURE"):
-    """The default surface of the project, group #1 of Table 7.1 ((k_l, k_s, H) = (16, 64, 0.8), m2 = 2e-4)."""
+    """The default surface of the project, group #1 of Table 7.1, on an ``n x n`` unit cell, E* = 1."""
     from petsc4py import PETSc
 
-    from roughpetsc.contact import ContactProblem
-    from roughpetsc.surfaces import Grid, fractal
+    from roughpetsc import ContactProblem, Grid
 
     grid = Grid(n, n)
-    return ContactProblem(grid, fractal(grid, 16, 64, 0.8, 2e-4, seed), 1.0, comm or PETSc.COMM_SELF,
-                          fft_effort=effort)
-
-
-def read_preset(path):
-    """``(name, options)`` of a solvers/*.opts file: options as a dict without the leading dash."""
-    options = {}
-    with open(path) as f:
-        for line in f:
-            line = line.split("#", 1)[0].strip()
-            if not line:
-                continue
-            key, _, value = line.partition(" ")
-            options[key.lstrip("-")] = value.strip()
-    return os.path.splitext(os.path.basename(path))[0], options
+    return ContactProblem(grid, group1_heights(grid, seed), 1.0, comm or PETSc.COMM_SELF, fft_effort=effort)
 
 
 def presets(names=None):
     """The presets of solvers/, in file-name order, or those named."""
-    found = dict(read_preset(p) for p in sorted(glob.glob(os.path.join(ROOT, "solvers", "*.opts"))))
+    found = preset_files.presets("solvers")
     if names:
         missing = [n for n in names if n not in found]
         if missing:
@@ -61,30 +58,22 @@ def load_controls(options):
     return options.get("tao_type", "") in ("", "almm")
 
 
-class options_set:
-    """Context manager: PETSc options set on entry and removed on exit (the rest of the database untouched)."""
+@contextlib.contextmanager
+def options_set(options):
+    """A preset's PETSc options in the database within the block, removed on exit (the rest untouched).
 
-    def __init__(self, options):
-        self.options = {k: v for k, v in options.items() if k != "kkt_rtol"}
+    The solvers' scoped manager (``default_options(..., replace=True)``) inserts and removes them; a
+    preset option that nothing read by the end of the block stops the study (misspelled?).
+    """
+    from roughpetsc.options import unused_options
+    from roughpetsc.solvers.tao_options import default_options
 
-    def __enter__(self):
-        from petsc4py import PETSc
-
-        for key, value in self.options.items():
-            PETSc.Options().setValue(key, value)
-        return self
-
-    def __exit__(self, *args):
-        from petsc4py import PETSc
-
-        from roughpetsc.options import unused_options
-
-        unused = set(unused_options()) & set(self.options)
-        for key in self.options:
-            PETSc.Options().delValue(key)
-        if unused and args[0] is None:
-            raise SystemExit("options nothing read (misspelled?): " + ", ".join("-" + k for k in sorted(unused)))
-        return False
+    preset = {key: value for key, value in options.items() if key != "kkt_rtol"}
+    with default_options(preset, replace=True):
+        yield
+        unused = set(unused_options() or ()) & set(preset)  # None: cannot check here (a warning says so)
+    if unused:
+        raise SystemExit("options nothing read (misspelled?): " + ", ".join("-" + k for k in sorted(unused)))
 
 
 def solve(problem, options, rtol, control="load", monitor=None, **load):
@@ -92,20 +81,33 @@ def solve(problem, options, rtol, control="load", monitor=None, **load):
 
     ``monitor(tao)``, if given, is added to the TAO's monitors.
     """
-    from roughpetsc.control import Solver
+    from roughpetsc import Solver
 
     start = time.perf_counter()
     with options_set(options):
         solver = Solver(problem, control, options.get("tao_type") or None, rtol)
         try:
             if monitor is not None:
-                tao = getattr(solver.backend, "tao", None) or solver.backend.qp.tao
-                tao.setMonitor(monitor)
+                solver.tao.setMonitor(monitor)
             result = solver.solve(**load)
             field = solver.fields()[0].copy()
         finally:
             solver.destroy()
     return result, field, time.perf_counter() - start
+
+
+def start_resumable(parser, folder, name, report_help):
+    """Start a resumable study: its arguments (``--report`` added), PETSc, and the rows it has saved.
+
+    Returns ``(args, path, rows)``: the parsed arguments, the JSON file ``folder/name.json`` of its
+    rows (:func:`save_rows`) and the rows already there (:func:`load_rows`).
+    """
+    parser.add_argument("--report", action="store_true", help=report_help)
+    args = parser.parse_args()
+    init()
+    os.makedirs(folder, exist_ok=True)
+    path = os.path.join(folder, name + ".json")
+    return args, path, load_rows(path)
 
 
 def load_rows(path):

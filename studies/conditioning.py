@@ -197,7 +197,7 @@ def main():
     text = [
         "# Conditioning of K on the contact set, and what preconditioning and deflation do",
         "",
-        f"Group #1 surface (seed 1), p* = {args.pstar}, contact set C of the converged solution (PK to 1e-12). "
+        f"Group #1 surface (the dissertation, 1), p* = {args.pstar}, contact set C of the converged solution (PK to 1e-12). "
         "Extreme eigenvalues by SLEPc Krylov-Schur (tolerance 1e-8); the last column checks the condition numbers "
         "against a dense eigen-decomposition where |C| <= 3000. Scaled units (rms height 1, cell length 1, E* = 1).",
         "",

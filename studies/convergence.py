@@ -3,12 +3,12 @@
     .venv/bin/python studies/convergence.py [--sizes 256 512 1024 2048] [--pstars 0.05 0.5 2 3.5]
                                             [--presets pk pk_plain ...] [--rtol 1e-10] [--max-time 60]
 
-Group #1 surface (seed 1) at each N and p*. The load-controlled presets (PK, ALMM) solve the load;
+Group #1 surface (the dissertation, 1) at each N and p*. The load-controlled presets (PK, ALMM) solve the load;
 the bound-constrained TAO types solve the displacement-controlled QP at the separation of that load
 (found first by preconditioned PK to 1e-12), so that every preset meets the same solution. Each solve
 runs from a cold start to ``--rtol`` or ``--max-time`` seconds (``-solve_max_time``).
 
-The seed's composite criterion (3.47), (3.48), (3.51) is evaluated alongside on PK runs with a TAO
+The dissertation's composite criterion (3.47), (3.48), (3.51) is evaluated alongside on PK runs with a TAO
 monitor (a separate, untimed run, since the monitor computes a fresh gap): the table gives the
 iteration at which it first holds and the natural residual there.
 
@@ -176,7 +176,7 @@ def write_report(args, records, figures, composite_rows):
     text = [
         "# Convergence of the solver presets",
         "",
-        f"Group #1 surface (seed 1), natural KKT residual ||min(p/pbar, g/sqrt(m0h))||_inf; every solve from a "
+        f"Group #1 surface (the dissertation, 1), natural KKT residual ||min(p/pbar, g/sqrt(m0h))||_inf; every solve from a "
         f"cold start to {args.rtol:g} or {args.max_time:g} s. Load-controlled presets (pk, pk_plain, almm) solve "
         "the load; the TAO bound types solve the displacement-controlled QP at the separation of the same load. "
         "FFT pairs count compliance and preconditioner applications. Shared 2-core machine: times are "
@@ -186,7 +186,7 @@ def write_report(args, records, figures, composite_rows):
         "",
         common.markdown_table(["preset", "p*", "iterations", "exponent"], growth),
         "",
-        "## The seed's composite criterion (3.47)+(3.48)+(3.51) on PK runs",
+        "## The dissertation's composite criterion (3.47)+(3.48)+(3.51) on PK runs",
         "",
         "Iteration at which it first holds, and the natural KKT residual of that iterate:",
         "",

@@ -1,5 +1,5 @@
 #!/bin/bash
-# The BEM ensembles behind studies/ensemble_figures.py (issue 6, item 5): seed ch. 7.3-7.4 (groups 1-3)
+# The BEM ensembles behind studies/ensemble_figures.py (issue 6, item 5): the dissertation, ch. 7.3-7.4 (groups 1-3)
 # and ch. 8 (groups 18-27). One `mpiexec -n 2` ensemble at a time (one surface per rank), each resumable:
 # rerun this script (or one stage of it) after a kill and the finished surfaces are kept; a larger
 # -ensemble_size extends a file, a smaller one (>= the surfaces it holds) finalises it.
@@ -12,9 +12,9 @@
 # along the 95-step history = 11,000 operator applications, ~35 s of CPU alone, 100-190 s of wall per rank
 # under the load of the time). The surfaces of a group differ little (A* of two group-18 surfaces within
 # 0.002 at every step), so a few surfaces per group give the mean to ~1e-3, and the grid matters more: the
-# seed used 1024^2 for groups 1-4 and 18-22 and 2048^2 for groups 23-27, 50 surfaces per group.
-#   group 18        : 512^2, 6 surfaces, the 95-step history (7.11) with Delta_1 = 0.2/30 (SPEC erratum)
-#   group 18 @ 1024 : 4 surfaces on the seed's grid, 33 steps (below): the grid effect on A*
+# dissertation used 1024^2 for groups 1-4 and 18-22 and 2048^2 for groups 23-27, 50 surfaces per group.
+#   group 18        : 512^2, 6 surfaces, the 95-step history (7.11) with Delta_1 = 0.2/30 (erratum, docs/conventions.md)
+#   group 18 @ 1024 : 4 surfaces on the dissertation's grid, 33 steps (below): the grid effect on A*
 #   groups 18, 22, 23, 27 @ 2048 : 33 steps, 2 surfaces by default (stages g18_2048 ...; group 18 ran 6
 #                     with G18_2048_SIZE=6): with the BCCG active set one 2048^2 surface along the 33
 #                     steps takes ~250 s of CPU
@@ -33,7 +33,9 @@
 # (Measured here: one 1024^2 surface along the 33 steps took ~670 s of wall per rank, ~10x a 512^2 one.)
 # Solver: the default (Polonsky-Keer, Fourier preconditioner), -kkt_rtol 1e-8 (the default).
 # After g01: `ensemble_figures.py --extras` (single process) solves the four field pictures of Figs.
-# 3.9/3.10 and the FD bandwidths; stage `extras` reruns it at the end for the files made since.
+# 3.9/3.10 (everything else the figures need, the FD bandwidths included, is in the ensemble files).
+# Files of format roughpetsc-ensemble-1 (before the FD bandwidths were stored) are read by the figures
+# but not resumed: a stage whose file is of that format needs a new file (move the old one away).
 set -u
 cd "$(dirname "$0")/.."
 source tools/env.sh

@@ -1,4 +1,4 @@
-"""MPI speed-up of an ensemble (SPEC 4: 8 surfaces, one surface per rank, serial FFTs, >= 1.9x on 2 ranks).
+"""MPI speed-up of an ensemble (the project target: 8 surfaces, one surface per rank, serial FFTs, >= 1.9x on 2 ranks).
 
     .venv/bin/python studies/ensemble_speedup.py [--N 256] [--size 8] [--loads history] [--ranks 2]
 
@@ -10,7 +10,7 @@ count), the ratio, and the largest difference between the two files (expected <=
 ``roughpetsc.ensemble.compare``); a markdown summary goes to studies/output/ensemble_speedup.md.
 
 ``--loads`` takes anything ``-ensemble_loads`` does, or ``history/K`` for every K-th step of the
-history (a documented subset for quick checks; the SPEC target is for the whole history). The machine
+history (a documented subset for quick checks; the target is for the whole history). The machine
 should be quiet and have at least RANKS cores: on a shared machine the ratio measures the neighbours.
 """
 
@@ -25,8 +25,8 @@ import time
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
+from roughpetsc.presets import ROOT
+
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
            "OMPI_MCA_rmaps_base_oversubscribe": "1", "OMPI_MCA_btl_vader_single_copy_mechanism": "none"}
 
@@ -123,7 +123,7 @@ def main():
     print(f"speed-up {ratio:.3f} (process wall time), {inner:.3f} (inside the run, without interpreter and MPI "
           f"start-up) on {args.ranks} ranks (target >= 1.9 on 2); files differ by at most {worst:.2e}")
     lines = [
-        "# Ensemble speed-up (SPEC 4: an ensemble of 8 surfaces on 2 ranks >= 1.9x faster than on 1)",
+        "# Ensemble speed-up (target: an ensemble of 8 surfaces on 2 ranks >= 1.9x faster than on 1)",
         "",
         f"`python studies/ensemble_speedup.py --N {args.N} --size {args.size} --loads {args.loads} --ranks "
         f"{args.ranks}" + (f" --options_file {args.options_file}" if args.options_file else "")

@@ -2,7 +2,7 @@
 
     .venv/bin/python studies/load_history.py [--n 1024] [--presets pk] [--repeat 2]
 
-Group #1 surface (seed 1), natural KKT residual 1e-8 at every step, one process. The history is
+Group #1 surface (the dissertation, 1), natural KKT residual 1e-8 at every step, one process. The history is
 solved in order by one Solver (each step starts from the previous solution scaled to the new load);
 the cold solve starts from a uniform pressure. Target (issue 5): history <= 10x the cold solve.
 Cold and history are alternated ``--repeat`` times and the medians compared (shared machine).
@@ -23,6 +23,13 @@ by more than 1e-2 (1e-3) of pbar, gives 0.469 (0.326): the cost is set by the er
 set, not by the nodes entering contact. Kept: the start's K p from the kept K p of the previous solutions
 and no fresh confirming K p inside PK (Solver certifies on a fresh gap and resumes PK if that fails):
 2 FFT pairs less per step, 0.478.
+
+Tried next (studies/load_path_recycling.py): a Galerkin start in the span of the last 2-10 solutions
+0.478-0.480 (N = 1024, 3 solutions: 0.516 against 0.525); with the previous solve's search directions added
+0.48; those directions as a recycled coarse space 0.54-0.78; a block coarse space 0.58 / 1.09 (iterations
+-17 % / -24 %, but its products cost 16 / 64 pairs a step, and it shortens the cold solve as much). At
+N = 1024 the kept predictor costs 0.525 (time 0.50-0.56), of which the tail below a natural residual of 1e-3
+is 0.36 on its own: no start that is only 1e-3 accurate reaches 0.35.
 """
 
 import argparse
@@ -35,7 +42,7 @@ import common
 
 
 def history_run(problem, options, loads):
-    from roughpetsc.control import Solver
+    from roughpetsc import Solver
 
     with common.options_set(options):
         solver = Solver(problem, "load", options.get("tao_type") or None, 1e-8)
@@ -54,7 +61,7 @@ def main():
     parser.add_argument("--repeat", type=int, default=2)
     args = parser.parse_args()
     common.init()
-    from roughpetsc.loads import history
+    from roughpetsc import load_history as history
 
     loads = history()
     problem = common.group1_problem(args.n)

@@ -1,4 +1,4 @@
-"""Peak resident memory of a whole run per grid point (SPEC 4: <= 40 doubles per grid point per rank).
+"""Peak resident memory of a whole run per grid point (target: <= 40 doubles per grid point per rank).
 
     .venv/bin/python studies/memory.py [--sizes 1024,2048,4096] [--ranks2 2048] [--stages 2048:1,2048:2]
 
@@ -79,13 +79,14 @@ def stages(N, folder):
     tracemalloc.start()
     from petsc4py import PETSc
 
-    sys.path.insert(0, ROOT)
-    from roughpetsc import cli, io, surfaces
-    from roughpetsc.contact import ContactProblem
-    from roughpetsc.control import Solver
+    from roughpetsc import ContactProblem, Grid, Solver, fractal, fractal_group, surface_moments
+    from roughpetsc.slab import gather_rows
+    from roughpetsc.store import load_path
+    from roughpetsc.surfaces import validate
 
     comm = PETSc.COMM_WORLD.tompi4py()
-    grid = surfaces.Grid(N, N, 1.0, 1.0)
+    grid = Grid(N, N, 1.0, 1.0)
+    group = fractal_group(1)
     state = {}
     rows = []
 
@@ -100,13 +101,13 @@ def stages(N, folder):
         rows.append((name, before, peak, after, live_before, live_peak, live_after))
 
     def surface():
-        state["heights"] = surfaces.validate(surfaces.fractal(grid, 16.0, 64.0, 0.8, 2e-4, 1), "-surface_type fractal")
+        state["heights"] = validate(fractal(grid, group["k_l"], group["k_s"], group["hurst"], group["m2"], 1))
 
     def problem():
         state["problem"] = ContactProblem(grid, state["heights"], 1.0, PETSc.COMM_WORLD, 1, "FFTW_MEASURE")
 
     def statistics():
-        state["statistics"] = cli.surface_statistics(grid, state["heights"], 1.0)
+        state["statistics"] = surface_moments(grid, state["heights"], 1.0)
 
     def solver():
         state["solver"] = Solver(state["problem"], "load", None, 1e-8)
@@ -116,22 +117,22 @@ def stages(N, folder):
 
     def fields():
         pressure, gap = state["solver"].fields()
-        state["fields"] = (cli._gather_rows(comm, pressure), cli._gather_rows(comm, gap))
+        state["fields"] = (gather_rows(comm, pressure), gather_rows(comm, gap))
 
     def hdf5():
         if comm.Get_rank():
             return
         summary = {"grid": [N, N], "steps": [state["result"].summary()]}
         pressure, gap = state["fields"]
-        io.write_h5(os.path.join(folder, "stages.h5"), summary,
-                    {"heights": state["heights"], "pressure": pressure, "gap": gap}, {0: state["result"].history})
+        load_path.write(os.path.join(folder, "stages.h5"), summary,
+                        {"heights": state["heights"], "pressure": pressure, "gap": gap}, {0: state["result"].history})
 
     for name, action in (("surface: fractal + validate (surfaces.from_options)", surface),
                          ("ContactProblem (Westergaard plans, symbols, heights, p_c)", problem),
-                         ("surface statistics (cli.surface_statistics)", statistics),
+                         ("surface statistics (surface_moments.surface_moments)", statistics),
                          ("Solver (PK work vectors)", solver),
                          ("solve, 50 PK iterations", solve),
-                         ("fields + gather (cli.run_solve)", fields),
+                         ("fields + gather (solve_mode.solve_path)", fields),
                          ("HDF5 file (-output)", hdf5)):
         stage(name, action)
     if comm.Get_rank() == 0:
@@ -252,7 +253,7 @@ def main():
            "`ctypes.CDLL('libc.so.6').mallopt(-4, 65536)` after that library is loaded lowered the peaks by only "
            "1-4 % here (the peak is set by arrays that are live together, not by retention)."),
         "- Live N^2-sized arrays at the peak (1 = one double per point per rank): the surface heights whole on "
-        "every rank (cli.run_solve: 1 on one rank, R on R ranks); ContactProblem: heights and p_c Vecs (2), the "
+        "every rank (solve_mode.solve_path: 1 on one rank, R on R ranks); ContactProblem: heights and p_c Vecs (2), the "
         "FFT real and complex buffers (2), the compliance, stiffness and preconditioner symbols stored as "
         "repeated real pairs (3), plus the exchange buffers of the slab transform on more than one rank; "
         "Solver: pressure and gap (2; the predictor's previous solution only on load paths), 6 Polonsky-Keer "
@@ -261,7 +262,7 @@ def main():
         "",
     ]
     text = "\n".join([
-        "# Peak resident memory per grid point (SPEC 4: <= 40 doubles per grid point per rank)",
+        "# Peak resident memory per grid point (target: <= 40 doubles per grid point per rank)",
         "",
         f"Generated {datetime.datetime.now().isoformat(timespec='seconds')} by `.venv/bin/python studies/memory.py"
         + "".join(f" {a}" for a in sys.argv[1:]) + f"` on {os.uname().nodename}.",

@@ -15,7 +15,7 @@ FINE = {"gw": (40,), "nayak_bush": (40, 40), "greenwood": (40, 40), "bgt": (24, 
 
 def main():
     os.makedirs(OUT, exist_ok=True)
-    d = 3 - 0.0469 * np.arange(65)           # the seed's 65 separations (7.3)
+    d = 3 - 0.0469 * np.arange(65)           # the dissertation's 65 separations (7.3)
     lines = ["# Early-contact curve timing (65 points, d* = 3 .. 0)", "",
              "| model | alpha_h | time [s] (best of 3) | max rel. error vs fine rule |", "|---|---|---|---|"]
     for name in ("gw", "nayak_bush", "greenwood", "bgt", "bgt_asymptotic"):

@@ -1,4 +1,4 @@
-"""MPI speed-up of one solve against the speed-up of the bare distributed FFT pair (SPEC 4, issue 5).
+"""MPI speed-up of one solve against the speed-up of the bare distributed FFT pair (issue 5).
 
     .venv/bin/python studies/mpi_speedup.py [--n 2048] [--pair-sizes 1024,2048] [--rounds 3]
                                             [--solve-rounds 3] [--no-solve] [--ranks 2]
@@ -12,7 +12,7 @@ Pair workers (at each N of --pair-sizes), one r2c + c2r pair each, no symbol mul
 
 - ``fftw2d``: the direct pyFFTW 2-D plan (FFTW_MEASURE, aligned), one rank only;
 - ``mpi4py-fft``: the bare distributed pair, mpi4py-fft ``PFFT(grid=(-1,), backend='pyfftw',
-  planner_effort='FFTW_MEASURE')`` -- the reference of the SPEC criterion;
+  planner_effort='FFTW_MEASURE')`` -- the reference of the speed-up criterion;
 - ``mpi4py-fft/fftw``, ``mpi4py-fft/collapse`` (``--variants all``: ``mpi4py-fft/patient``):
   mpi4py-fft's own options (its 2.0.4 has no ``communication=`` option, only Alltoallw); the
   ``fftw`` backend (mpi4py-fft's own FFTW wrapper) runs in a worker of its own because it crashes
@@ -20,8 +20,9 @@ Pair workers (at each N of --pair-sizes), one r2c + c2r pair each, no symbol mul
 - ``slab/shared``, ``slab/alltoall``: :class:`roughpetsc.slab.SlabTransform` with its two exchanges;
 - ``shell``: one MatMult of ``Westergaard(Grid(n, n), 1.0, COMM_WORLD).mat()`` as
   ``roughpetsc.westergaard`` is (1 rank: direct 2-D plan; several: :class:`roughpetsc.slab.SlabTransform`);
-  ``shell/mpi4py-fft``: the same with the old multi-rank transform, ``westergaard._SlabTransform``
-  (mpi4py-fft PFFT), for comparison (its 1-rank time is ``shell``'s).
+  ``shell/mpi4py-fft``: the same with the old multi-rank transform, :class:`PfftTransform` below
+  (mpi4py-fft PFFT, which roughpetsc used before roughpetsc.slab), for comparison (its 1-rank time is
+  ``shell``'s).
 
 Solve workers: one cold load-controlled solve of the group-1 surface (N = --n, k_l = 16, k_s = 64,
 H = 0.8, m2 = 2e-4, seed 1, E* = 1) at p* = 0.5 to a natural KKT residual of 1e-8 with the default
@@ -30,7 +31,7 @@ the transform as it is (``current``) and with the old mpi4py-fft one (``mpi4py-f
 the transform class each run used.
 
 Prints and writes studies/output/mpi_speedup.md: pair times, speed-ups (1 rank / RANKS ranks; the
-solve's 1-rank time always uses the direct 2-D plan), and the SPEC ratio
+solve's 1-rank time always uses the direct 2-D plan), and the ratio
 solve speed-up / bare-pair (mpi4py-fft) speed-up, which must be >= 0.9. The load average of the
 machine is recorded around every worker.
 """
@@ -45,7 +46,6 @@ import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
            "OMPI_MCA_rmaps_base_oversubscribe": "1", "OMPI_MCA_btl_vader_single_copy_mechanism": "none"}
 BASE_VARIANTS = ["fftw2d", "mpi4py-fft", "mpi4py-fft/fftw", "mpi4py-fft/collapse", "slab/shared",
@@ -54,22 +54,51 @@ ALL_VARIANTS = BASE_VARIANTS + ["mpi4py-fft/patient"]
 
 
 # --------------------------------------------------------------------------- workers (under mpiexec)
+class PfftTransform:
+    """The 2-D real FFT pair over MPI ranks that roughpetsc used before its slab transform.
+
+    mpi4py-fft's slab decomposition along axis 0 (``PFFT(grid=(-1,), backend='pyfftw')``), with the
+    interface of :class:`roughpetsc.slab.SlabTransform` that :class:`roughpetsc.westergaard.Westergaard`
+    uses (``local_rows``, ``spectral_slice``, ``filter``, ``destroy``).
+    """
+
+    def __init__(self, grid, comm, effort):
+        from mpi4py_fft import PFFT, newDistArray
+
+        self.fft = PFFT(comm, grid.shape, axes=(0, 1), dtype=float, grid=(-1,), backend="pyfftw",
+                        planner_effort=effort)
+        self.real = newDistArray(self.fft, False)
+        self.spectrum = newDistArray(self.fft, True)
+        self.local_rows = self.fft.local_slice(False)[0]
+        self.spectral_slice = self.fft.local_slice(True)
+
+    def filter(self, source, target, symbol):
+        self.real[...] = source
+        self.fft.forward(self.real, self.spectrum, normalize=False)
+        self.spectrum.view("float64").__imul__(symbol)
+        self.fft.backward(self.spectrum, self.real, normalize=False)
+        target[...] = self.real
+
+    def destroy(self):
+        self.fft.destroy()
+
+
 @contextlib.contextmanager
 def _transform(name):
     """Within the block, Westergaard builds its multi-rank transform as ``name`` says (what-if runs).
 
-    ``current``: as roughpetsc.westergaard is; ``mpi4py-fft``: its kept ``_SlabTransform`` (mpi4py-fft
-    PFFT), swapped in for roughpetsc.slab.SlabTransform, which westergaard imports when it builds one.
+    ``current``: as roughpetsc.westergaard is; ``mpi4py-fft``: :class:`PfftTransform`, swapped in for
+    roughpetsc.slab.SlabTransform, which westergaard imports when it builds one.
     """
-    from roughpetsc import slab, westergaard
+    from roughpetsc import slab
 
     if name == "current":
         yield
         return
-    if name != "mpi4py-fft" or not hasattr(westergaard, "_SlabTransform"):
+    if name != "mpi4py-fft":
         raise ValueError(f"unknown transform {name!r}")
     kept = slab.SlabTransform
-    slab.SlabTransform = westergaard._SlabTransform
+    slab.SlabTransform = PfftTransform
     try:
         yield
     finally:
@@ -89,7 +118,7 @@ class _Pair:
         import pyfftw
         from petsc4py import PETSc
 
-        from roughpetsc.surfaces import Grid
+        from roughpetsc import Grid
 
         rng = np.random.default_rng(comm.Get_rank())
         self._destroy = []
@@ -140,7 +169,7 @@ class _Pair:
 
             with _transform("current" if name == "shell" else "mpi4py-fft"):
                 operator = westergaard.Westergaard(grid, 1.0, PETSc.COMM_WORLD)
-            self.label = _label(operator._transform)
+            self.label = _label(operator.transform)
             mat = operator.mat()
             x, y = operator.vec(), operator.vec()
             x.setRandom()
@@ -194,15 +223,14 @@ def worker_solve(n, transform):
     from mpi4py import MPI
     from petsc4py import PETSc
 
-    from roughpetsc.contact import ContactProblem
-    from roughpetsc.control import Solver
-    from roughpetsc.surfaces import Grid, fractal
+    from roughpetsc import ContactProblem, Grid, Solver, fractal, fractal_group
 
+    group = fractal_group(1)
     grid = Grid(n, n)
-    heights = fractal(grid, 16.0, 64.0, 0.8, 2e-4, 1)
+    heights = fractal(grid, group["k_l"], group["k_s"], group["hurst"], group["m2"], 1)
     with _transform(transform):
         problem = ContactProblem(grid, heights, 1.0, PETSc.COMM_WORLD)
-    label = _label(problem.operator._transform)
+    label = _label(problem.operator.transform)
     solver = Solver(problem, "load", None, 1e-8)
     try:
         start_cpu = time.process_time()
@@ -360,7 +388,7 @@ def report(args, sizes, ranks, pair, solves, loads, started, labels):
     lines += ["", "Speed-up = 1-rank time / %d-rank time of the same row; `shell` is one MatMult of the Westergaard "
               "shell Mat (1 rank: direct 2-D FFTW plan; %d ranks: %s), `shell/mpi4py-fft` the same with the old "
               "mpi4py-fft transform (its 1-rank time is `shell`'s). `slab/*` is roughpetsc.slab.SlabTransform "
-              "with each exchange. The SPEC's bare distributed pair is the `mpi4py-fft` row."
+              "with each exchange. The reference bare distributed pair is the `mpi4py-fft` row."
               % (many, many, labels.get("shell", "?"))]
     if solves:
         n = args.n
@@ -389,7 +417,7 @@ def report(args, sizes, ranks, pair, solves, loads, started, labels):
         finals = {round(o["A"], 10) for outs in solves.values() for o in outs}
         lines += ["", f"Bare distributed FFT pair (mpi4py-fft) speed-up at N={n}: {bare:.2f} wall, "
                   f"{bare_cpu:.2f} CPU. "
-                  "ratio = solve speed-up / bare-pair speed-up; SPEC target: ratio wall >= 0.9. "
+                  "ratio = solve speed-up / bare-pair speed-up; target: ratio wall >= 0.9. "
                   "'per K' divides each solve's time by its operator applications (the iteration count of "
                   "a solve can change from run to run: FFTW_MEASURE may pick other plans, hence other "
                   f"round-off, and the active set path follows it). A* of all runs: {sorted(finals)}."]

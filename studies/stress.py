@@ -1,13 +1,14 @@
-"""Stress tests of numerical stability (SPEC 4, Reliability), judged independently of the solver.
+"""Stress tests of numerical stability (reliability), judged independently of the solver.
 
     .venv/bin/python studies/stress.py [--quick] [--keep DIR]
 
 Every case is one command-line run, ``python -m roughpetsc ... -json J -output H.h5``, in a subprocess (so
 crashes, tracebacks, hangs and exit codes are seen). Its answer is then checked from the files alone with our
-own numpy code, not with roughpetsc's:
+own numpy code, not with the solver's (FFTW, PETSc):
 
-* the pressure surface p_c = F^-1[pi E* |k| F[h]] and sqrt(m0^p) = rms(p_c), sqrt(m0^h) = rms(h), from the
-  heights (our own input array for surfaces given as files, the HDF5 ``heights`` otherwise);
+* the pressure surface p_c = F^-1[pi E* |k| F[h]] (2.47; numpy's FFT in ``roughpetsc.pressure_surface``, not the
+  solver's operator) and sqrt(m0^p) = rms(p_c), sqrt(m0^h) = rms(h), from the heights (our own input array for
+  surfaces given as files, the HDF5 ``heights`` otherwise);
 * the target load pbar = p* sqrt(m0^p) (or the -pbar given);
 * the gap g = w + d - h of the final pressure, w = F^-1[F[p] / (pi E* |k|)] (k in cycles/length, the k = 0 mode
   zero), d the recorded ``separation``; from it the natural KKT residual ||min(p/pbar, g/sqrt(m0h))||_inf, the
@@ -37,13 +38,14 @@ import time
 
 import numpy as np
 
+from roughpetsc import Grid, fractal, fractal_group, pressure_surface  # numpy only: the surface given as a file
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-from roughpetsc.surfaces import Grid, fractal  # noqa: E402  (numpy only: the surface given as a file)
 
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
            "OMPI_MCA_rmaps_base_oversubscribe": "1", "OMPI_MCA_btl_vader_single_copy_mechanism": "none"}
-GROUP1 = dict(kl=16.0, ks=64.0, H=0.8, m2=2e-4, seed=1)
+GROUP1 = {"kl": fractal_group(1)["k_l"], "ks": fractal_group(1)["k_s"], "H": fractal_group(1)["hurst"],
+          "m2": fractal_group(1)["m2"], "seed": 1}  # options/group01.opts, seed 1
 PSTARS = (1e-3, 1e-2, 0.1, 0.5, 2.0, 3.5, 5.0, 10.0)
 RTOL = 1e-8
 # Independent checks: how close the recomputed quantities must be to what the run recorded.
@@ -139,24 +141,12 @@ def cases(pstar_c):
 # Our own numerics (numpy only)
 # ---------------------------------------------------------------------------------------------------------
 
-def modulus_of_k(shape, l0, l1):
-    k0 = np.fft.fftfreq(shape[0], d=l0 / shape[0])[:, None]
-    k1 = np.fft.rfftfreq(shape[1], d=l1 / shape[1])[None, :]
-    return np.hypot(k0, k1)
-
-
 def compliance(p, l0, l1, E_star):
-    """w = F^-1[F[p] / (pi E* |k|)], k != 0; zero k = 0 mode."""
-    k = modulus_of_k(p.shape, l0, l1)
+    """w = F^-1[F[p] / (pi E* |k|)], k != 0; zero k = 0 mode (3.33), with numpy's FFT."""
+    k = np.hypot(*Grid(p.shape[0], p.shape[1], l0, l1).rfft_wavenumbers())
     with np.errstate(divide="ignore"):
         symbol = np.where(k > 0, 1.0 / (np.pi * E_star * k), 0.0)
     return np.fft.irfft2(np.fft.rfft2(p) * symbol, s=p.shape)
-
-
-def pressure_surface(h, l0, l1, E_star):
-    """p_c = F^-1[pi E* |k| F[h]] (2.47)."""
-    k = modulus_of_k(h.shape, l0, l1)
-    return np.fft.irfft2(np.fft.rfft2(h) * (np.pi * E_star * k), s=h.shape)
 
 
 def prepare_surfaces(folder):
@@ -173,7 +163,7 @@ def prepare_surfaces(folder):
     for name, array in arrays.items():
         paths[name] = os.path.join(folder, f"{name}.npy")
         np.save(paths[name], array)
-    pc = pressure_surface(h0, 1.0, 1.0, 1.0)
+    pc = pressure_surface(grid, h0, 1.0)
     return paths, float(-pc.min() / math.sqrt(np.mean(pc ** 2)))
 
 
@@ -237,7 +227,7 @@ def independent_check(case, paths):
     if (n0, n1) != (case.N, case.N) and not case.surface:
         failures.append(f"grid {h.shape} is not {case.N}x{case.N}")
     rms_h = math.sqrt(np.mean(h ** 2))
-    pc = pressure_surface(h, l0, l1, E)
+    pc = pressure_surface(Grid(n0, n1, l0, l1), h, E)
     rms_p = math.sqrt(np.mean(pc ** 2))
     if case.pbar is not None:
         pbar_target = case.pbar_value
@@ -463,7 +453,7 @@ def main():
     header = ("| case | range | N | exit | reason (JSON) | its | A* | g* | KKT nat (run) | KKT nat (ours) | "
               "load err (ours) | independent checks | wall s | verdict |")
     lines = [
-        "# Stress tests of numerical stability (SPEC 4, Reliability)",
+        "# Stress tests of numerical stability (reliability)",
         "",
         f"Generated {datetime.datetime.now().isoformat(timespec='seconds')} by "
         f"`.venv/bin/python studies/stress.py{' --quick' if args.quick else ''}` on {os.uname().nodename}.",

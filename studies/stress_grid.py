@@ -33,6 +33,7 @@ import time
 import numpy as np
 
 import common
+from roughpetsc import Grid, bisinusoid, fractal, fractal_group, pressure_surface, wave  # PETSc-free names
 
 OUT = os.path.join(common.OUTPUT, "stress")
 LOADS = ("0.01", "0.5", "3", "near complete")
@@ -43,10 +44,10 @@ NAMED = re.compile(r"best (of )?natural residual|time limit|stagnation|load erro
 
 
 def surface(kind, n):
-    from roughpetsc.surfaces import Grid, bisinusoid, fractal, wave
-
+    """The surface ``kind`` of :data:`SURFACES` on an ``n x n`` unit cell: ``(grid, heights)``."""
     grid = Grid(n, n)
-    rough = fractal(grid, min(16, n // 16), min(64, n // 4), 0.8, 2e-4, 5)
+    group = fractal_group(1)  # group #1 of Table 7.1, its wavenumbers capped for the small grids
+    rough = fractal(grid, min(group["k_l"], n // 16), min(group["k_s"], n // 4), group["hurst"], group["m2"], 5)
     if kind == "fractal":
         return grid, rough
     if kind == "wave":
@@ -60,24 +61,25 @@ def surface(kind, n):
 
 
 def independent(grid, heights, E_star, pressure, gap):
-    """Natural residual, load and complete-contact check of a returned field, with numpy's FFT only."""
+    """Natural residual, load and complete-contact check of a returned field, with numpy's FFT (and the pressure
+    surface (2.47) of :func:`roughpetsc.pressure_surface`, numpy's FFT too)."""
     n0, n1 = grid.shape
     k = np.hypot(np.fft.fftfreq(n0, grid.l0 / n0)[:, None], np.fft.rfftfreq(n1, grid.l1 / n1)[None, :])
     with np.errstate(divide="ignore"):
         compliance = np.where(k > 0, 1.0 / (np.pi * E_star * k), 0.0)
     h = heights - heights.mean()
     sqrt_m0h = np.sqrt(np.mean(h ** 2))
-    pressure_surface = np.fft.irfft2(np.pi * E_star * k * np.fft.rfft2(h), s=grid.shape)
-    sqrt_m0p = np.sqrt(np.mean(pressure_surface ** 2))
+    complete_pressure = pressure_surface(grid, h, E_star)
+    sqrt_m0p = np.sqrt(np.mean(complete_pressure ** 2))
     elastic = np.fft.irfft2(compliance * np.fft.rfft2(pressure), s=grid.shape) - h
     separation = np.mean(gap - elastic)
     ours = elastic + separation
-    return {"sqrt_m0p": sqrt_m0p, "pressure_surface": pressure_surface,
+    return {"sqrt_m0p": sqrt_m0p, "pressure_surface": complete_pressure,
             "gap_mismatch": float(np.abs(ours - gap).max() / sqrt_m0h), "gap": ours / sqrt_m0h}
 
 
 def run_cell(problem, grid, heights, preset, options, pstar, rtol, max_time):
-    from roughpetsc.control import Solver
+    from roughpetsc import Solver
 
     row = {"pstar": pstar}
     start = time.perf_counter()
@@ -182,16 +184,11 @@ def main():
     parser.add_argument("--sizes", type=int, nargs="*", default=[64, 256, 1024])
     parser.add_argument("--max-time", type=float, nargs="*", default=[20.0, 60.0, 120.0])
     parser.add_argument("--presets", nargs="*", default=None)
-    parser.add_argument("--report", action="store_true", help="only rewrite the report from the JSON")
-    args = parser.parse_args()
-    common.init()
+    args, path, rows = common.start_resumable(parser, OUT, "stress_grid", "only rewrite the report from the JSON")
     from petsc4py import PETSc
 
-    from roughpetsc.contact import ContactProblem
+    from roughpetsc import ContactProblem
 
-    os.makedirs(OUT, exist_ok=True)
-    path = os.path.join(OUT, "stress_grid.json")
-    rows = common.load_rows(path)
     presets = list(common.presets(args.presets))
     done = {key_of(r) for r in rows}
     for n, max_time in zip(args.sizes, args.max_time) if not args.report else ():

@@ -1,4 +1,4 @@
-"""Regenerate the seed's Tables 7.2-7.7 and 8.2-8.3 for our generator, the rule of thumb (7.10) and PDF plots.
+"""Regenerate the dissertation's Tables 7.2-7.7 and 8.2-8.3 for our generator, the rule of thumb (7.10) and PDF plots.
 
 Usage (from the repository root, Debian's python)::
 
@@ -6,7 +6,7 @@ Usage (from the repository root, Debian's python)::
 
 Realisation i of a group has seed i + 1 (i = 0..R-1). Writes under
 ``studies/output/statistics/``: ``surface_statistics.md`` (tables beside the
-seed's numbers), ``ensemble.json`` (all means, stds and PDF distances),
+dissertation's numbers), ``ensemble.json`` (all means, stds and PDF distances),
 ``pdf_groupNN_{h,p}.png`` and ``rule_of_thumb.png``. ``--render-only`` rebuilds
 the markdown and figures from ``ensemble.json``.
 """
@@ -19,27 +19,16 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-from roughpetsc import spectra, stats_mode  # noqa: E402
-from roughpetsc.surfaces import Grid, fractal, fractal_amplitude  # noqa: E402
+from roughpetsc import Grid, fractal, fractal_amplitude, spectra, stats_mode, stats_output
+from roughpetsc.presets import fractal_groups
 
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "output", "statistics")
 
-# Tables 7.1 and 8.1: group -> (k_l, k_s, H, N)
-GROUPS = {
-    1: (16, 64, 0.8, 1024), 2: (16, 128, 0.8, 1024), 3: (16, 256, 0.8, 1024), 4: (16, 512, 0.8, 1024),
-    5: (4, 64, 0.8, 1024), 6: (4, 128, 0.8, 1024), 7: (4, 256, 0.8, 1024), 8: (4, 512, 0.8, 1024),
-    9: (1, 64, 0.8, 1024), 10: (1, 128, 0.8, 1024), 11: (1, 256, 0.8, 1024), 12: (1, 512, 0.8, 1024),
-    13: (4, 128, 0.1, 1024), 14: (4, 128, 0.3, 1024), 15: (4, 128, 0.5, 1024), 16: (4, 128, 0.7, 1024),
-    17: (4, 128, 0.9, 1024),
-    18: (16, 64, 0.1, 1024), 19: (16, 64, 0.3, 1024), 20: (16, 64, 0.5, 1024), 21: (16, 64, 0.7, 1024),
-    22: (16, 64, 0.9, 1024),
-    23: (16, 128, 0.1, 2048), 24: (16, 128, 0.3, 2048), 25: (16, 128, 0.5, 2048), 26: (16, 128, 0.7, 2048),
-    27: (16, 128, 0.9, 2048),
-}
+# Tables 7.1 and 8.1 as options/groupNN.opts type them: group -> (k_l, k_s, H, N); every group has m2 = 2e-4.
+GROUPS = {number: (group["k_l"], group["k_s"], group["hurst"], group["n"]) for number, group in fractal_groups().items()}
+M2 = {number: group["m2"] for number, group in fractal_groups().items()}
 
-# The seed's numbers as printed (None: illegible in the text of the dissertation we have).
+# The dissertation's numbers as printed (None: illegible in the text of the dissertation we have).
 # Table 7.2: mean m20, m02, m40, m04, m60, m06 of h.
 SEED_7_2 = {
     1: (1.97e-4, 1.97e-4, 9.00, 9.02, 6.59e5, 6.59e5), 2: (1.91e-4, 1.91e-4, 27.01, 26.97, 6.94e6, 6.94e6),
@@ -98,14 +87,14 @@ def group_statistics(group, realisations, edges):
     grid = Grid(n, n, 1.0, 1.0)
     entries = []
     for i in range(realisations):
-        heights = fractal(grid, k_l, k_s, hurst, 2e-4, i + 1)
+        heights = fractal(grid, k_l, k_s, hurst, M2[group], i + 1)
         scalars, counts = stats_mode.surface_statistics(grid, heights, SETTINGS, edges)
         central = spectra.isotropic_mean(spectra.fd_moments(grid, heights, spectra.MOMENT_ORDERS, "central"))
         scalars.update({f"m{order}h_central": value for order, value in central.items()})
         entries.append((i, i + 1, scalars, counts, grid))
     summary = stats_mode.ensemble_summary(entries, edges)
-    closed = spectra.fractal_closed_forms(k_l, k_s, hurst, fractal_amplitude(k_l, k_s, hurst, 2e-4))
-    document = stats_mode.result_document(
+    closed = spectra.fractal_closed_forms(k_l, k_s, hurst, fractal_amplitude(k_l, k_s, hurst, M2[group]))
+    document = stats_output.result_document(
         summary, SETTINGS, {"k_l": k_l, "k_s": k_s, "H": hurst, "N": n}, stats_mode.flatten_closed_forms(closed),
         stats_mode.pdf_distances(summary), [i + 1 for i in range(realisations)], grid)
     document.pop("per_surface")
@@ -143,8 +132,8 @@ def deviation(ours, seed):
 
 
 def table_7_2(results):
-    lines = ["| # | m20 ours | m20 seed | m02 ours | m02 seed | m40 ours | m40 seed | m04 ours | m04 seed | "
-             "m60 ours | m60 seed | m06 ours | m06 seed |", "|" + "---|" * 13]
+    lines = ["| # | m20 ours | m20 dissertation | m02 ours | m02 dissertation | m40 ours | m40 dissertation | m04 ours | m04 dissertation | "
+             "m60 ours | m60 dissertation | m06 ours | m06 dissertation |", "|" + "---|" * 13]
     for group in range(1, 18):
         d = results[str(group)]
         seed = SEED_7_2[group]
@@ -156,7 +145,7 @@ def table_7_2(results):
 
 
 def table_7_3(results):
-    lines = ["| # | m20p ours | m20p seed | m02p ours | m02p seed | m40p ours | m40p seed | m04p ours | m04p seed |",
+    lines = ["| # | m20p ours | m20p dissertation | m02p ours | m02p dissertation | m40p ours | m40p dissertation | m04p ours | m04p dissertation |",
              "|" + "---|" * 9]
     for group in range(1, 18):
         d = results[str(group)]
@@ -168,9 +157,9 @@ def table_7_3(results):
 
 
 def table_moments_vs_closed(results, groups):
-    """Tables 7.4-7.6: closed form, our finite differences (seed stencils), our spectrum, seed Num."""
-    lines = ["| # | moment | closed form | ours FD (seed stencils) | ours FD (repeated central) | ours spectrum "
-             "| seed Num | ours FD vs seed |", "|" + "---|" * 8]
+    """Tables 7.4-7.6: closed form, our finite differences (the dissertation's stencils), our spectrum, the dissertation's Num."""
+    lines = ["| # | moment | closed form | ours FD (the dissertation's stencils) | ours FD (repeated central) | ours spectrum "
+             "| the dissertation's Num | ours FD vs dissertation |", "|" + "---|" * 8]
     for group in groups:
         d = results[str(group)]
         seed_h = SEED_NUM_H.get(group, (None,) * 4)
@@ -188,7 +177,7 @@ def table_moments_vs_closed(results, groups):
 
 
 def table_7_7(results):
-    lines = ["| # | alpha^h ours (mean ± std) | alpha^h seed | alpha^p ours | alpha^p seed | inside seed spread? |",
+    lines = ["| # | alpha^h ours (mean ± std) | alpha^h dissertation | alpha^p ours | alpha^p dissertation | inside the dissertation's spread? |",
              "|---|---|---|---|---|---|"]
     for group, ((ah, sh), (ap, sp)) in SEED_7_7.items():
         d = results[str(group)]
@@ -202,7 +191,7 @@ def table_8(results, seed_table, field):
     keys = [f"m0{field}_fd", f"m2{field}_fd", f"m4{field}_fd", f"alpha_{field}"]
     closed_keys = [f"m0{field}", f"m2{field}", f"m4{field}", f"alpha_{field}"]
     names = [f"m0{field}", f"m2{field}", f"m4{field}", f"alpha^{field}"]
-    header = "| # | N | " + " | ".join(f"{n} closed | {n} ours | {n} seed Num | dev." for n in names) + " |"
+    header = "| # | N | " + " | ".join(f"{n} closed | {n} ours | {n} the dissertation's Num | dev." for n in names) + " |"
     lines = [header, "|" + "---|" * (2 + 4 * len(names))]
     for group, seed in seed_table.items():
         d = results[str(group)]
@@ -271,22 +260,22 @@ def plot_rule_of_thumb(rows, path):
 def render(results, realisations_note, elapsed):
     for group in PLOT_GROUPS:
         if str(group) in results:
-            stats_mode.plot_pdfs(os.path.join(OUT, f"pdf_group{group:02d}"), results[str(group)])
+            stats_output.plot_pdfs(os.path.join(OUT, f"pdf_group{group:02d}"), results[str(group)])
     rows = rule_of_thumb_rows(results)
     plot_rule_of_thumb(rows, os.path.join(OUT, "rule_of_thumb.png"))
-    text = f"""# Surface statistics of our generator against the seed (Tables 7.2-7.7, 8.2-8.3)
+    text = f"""# Surface statistics of our generator against the dissertation (Tables 7.2-7.7, 8.2-8.3)
 
 Generated by `studies/surface_statistics.py`. {realisations_note} Total run time {elapsed:.0f} s.
 Surfaces: `roughpetsc.surfaces.fractal` (sec. 7.1), unit cell, m2 = 2e-4, E* = 1 (so p* = p); realisation i has
 seed i + 1. "ours" = mean ± sample std over the realisations. Moments by finite differences (7.6)/(7.7) with the
-seed's stencils (central first derivative, three-point second derivative, central difference of the three-point
+dissertation's stencils (central first derivative, three-point second derivative, central difference of the three-point
 second derivative for the third); "repeated central" is the literal reading (central difference applied n/2
-times); "spectrum" is the discrete (2.12). The seed's numbers are as printed ("—": illegible in our copy).
+times); "spectrum" is the discrete (2.12). The dissertation's numbers are as printed ("—": illegible in our copy).
 PDF distances: L1 = sum over bins of width 0.25 on [-5, 5] (plus the mass outside) of |measured − closed-form
 probability| (= 2 × total variation); "noise" is the L1 expected from sampling alone for the same number of
 independent samples.
 
-## Which "Num" definition reproduces the seed (Tables 7.4-7.6)
+## Which "Num" definition reproduces the dissertation (Tables 7.4-7.6)
 
 {table_moments_vs_closed(results, [1, 2, 3, 4, 5, 9, 13, 14, 15, 16, 17])}
 
@@ -343,8 +332,8 @@ def main():
         results = compute_all(args.realisations, args.realisations_2048, args.groups)
         elapsed = time.time() - start
         note = (f"Realisations: {args.realisations} per 1024^2 group, {args.realisations_2048} per 2048^2 group "
-                f"(the seed used 1000).")
-        stats_mode.write_json(cache, {"groups": results, "note": note, "elapsed": elapsed})
+                f"(the dissertation used 1000).")
+        stats_output.write_json(cache, {"groups": results, "note": note, "elapsed": elapsed})
     render(results, note, elapsed)
     print(f"wrote {OUT}/surface_statistics.md in {time.time() - start:.0f} s")
 

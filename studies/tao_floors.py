@@ -83,12 +83,7 @@ def main():
     parser.add_argument("--controls", nargs="*", default=["displacement", "load"])
     parser.add_argument("--rtol", type=float, default=1e-10)
     parser.add_argument("--max-time", type=float, default=300.0)
-    parser.add_argument("--report", action="store_true", help="only rewrite tao_floors.md from the JSON")
-    args = parser.parse_args()
-    common.init()
-    os.makedirs(OUT, exist_ok=True)
-    path = os.path.join(OUT, "tao_floors.json")
-    rows = common.load_rows(path)
+    args, path, rows = common.start_resumable(parser, OUT, "tao_floors", "only rewrite tao_floors.md from the JSON")
     done = {row_key(r) for r in rows}
     presets = common.presets(args.presets)
     for effort in args.efforts if not args.report else ():

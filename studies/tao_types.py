@@ -2,7 +2,7 @@
 
     .venv/bin/python studies/tao_types.py [rtol]
 
-128^2 group-#1 surface (seed 1), p* = 0.5: PK to 1e-12 gives d; each type then solves at that d to rtol
+128^2 group-#1 surface (the dissertation, 1), p* = 0.5: PK to 1e-12 gives d; each type then solves at that d to rtol
 (default 1e-8). Prints natural residual, iterations, operator applications, seconds, reason and
 max|p - p_PK| / max p_PK.
 """
@@ -11,11 +11,10 @@ import petsc4py
 petsc4py.init([sys.argv[0]])
 from petsc4py import PETSc
 import numpy as np
-from roughpetsc.contact import ContactProblem
-from roughpetsc.control import Solver
-from roughpetsc.surfaces import Grid, fractal
+from roughpetsc import ContactProblem, Grid, Solver, fractal, fractal_group
 grid = Grid(128, 128)
-h = fractal(grid, 16, 64, 0.8, 2e-4, 1)
+group = fractal_group(1)
+h = fractal(grid, group["k_l"], group["k_s"], group["hurst"], group["m2"], 1)
 prob = ContactProblem(grid, h, 1.0, PETSc.COMM_SELF, fft_effort="FFTW_ESTIMATE")
 rtol = float(sys.argv[1]) if len(sys.argv) > 1 else 1e-8
 s = Solver(prob, "load", None, 1e-12)

@@ -18,9 +18,7 @@ import petsc4py
 petsc4py.init([sys.argv[0]])
 from petsc4py import PETSc  # noqa: E402
 
-from roughpetsc.contact import ContactProblem  # noqa: E402
-from roughpetsc.control import Solver  # noqa: E402
-from roughpetsc.surfaces import Grid, wave  # noqa: E402
+from roughpetsc import ContactProblem, Grid, Solver, wave  # noqa: E402
 
 E_STAR, AMPLITUDE = 2.5, 0.01
 RATIOS = (0.05, 0.3, 0.7, 0.95)

@@ -3,7 +3,7 @@
     .venv/bin/python studies/work_precision.py [--n 512] [--pstars 0.05 0.5 2 3.5] [--presets pk bnls ...]
                                                [--tolerances 1e-2 ... 1e-10] [--max-time 20]
 
-Group #1 surface (seed 1). For each regime p*, a reference is solved to natural KKT residual 1e-13 by the
+Group #1 surface (the dissertation, 1). For each regime p*, a reference is solved to natural KKT residual 1e-13 by the
 default solver (preconditioned PK with the BCCG active set) and checked against the published PK
 (``pk_plain``) to 1e-12, an independent algorithm. Each preset then solves the same problem from a
 cold start to each tolerance of ``--tolerances`` in turn; the error of A*, of gbar and of the pressure
@@ -109,7 +109,7 @@ def write_report(args, rows, references, figures):
     with open(os.path.join(OUT, "work_precision.json"), "w") as f:
         json.dump({"rows": rows, "references": references}, f)
     text = ["# Run time against error (work-precision)", "",
-            f"Group #1 surface (seed 1), N = {args.n}, one process, cold starts. Each point is one solve to a "
+            f"Group #1 surface (the dissertation, 1), N = {args.n}, one process, cold starts. Each point is one solve to a "
             "natural KKT residual tolerance; errors are against a reference solved to 1e-13 by preconditioned "
             "PK (BCCG), itself checked against the published PK to 1e-12. Load-controlled presets (pk, pk_plain, "
             "almm) solve the load; the TAO bound types solve the displacement-controlled QP at the reference "

@@ -150,3 +150,24 @@ def test_time_limit_is_reported_as_not_converged(tmp_path):
     assert out.returncode == 3
     step = json.load(open(tmp_path / "t.json"))["steps"][0]
     assert not step["converged"] and step["reason"].startswith("DIVERGED_USER")
+
+
+def test_every_mode_is_one_module_with_an_option_table_and_run():
+    from roughpetsc import cli
+
+    assert list(cli.MODES) == ["solve", "stats", "models", "ensemble"]
+    for module in cli.MODES.values():
+        assert module.OPTIONS and all(len(option) == 3 for option in module.OPTIONS)
+        assert callable(module.run)
+
+
+def test_a_library_error_is_reported_by_the_option_that_set_its_parameter():
+    from roughpetsc.errors import ParameterError, UserError
+    from roughpetsc.mode_settings import options_named, user_message
+
+    assert user_message(ParameterError("k_s", "exceeds the Nyquist wavenumber")) == \
+        "-surface_ks: exceeds the Nyquist wavenumber"
+    assert user_message(ParameterError("depth", "must be positive")) == "depth: must be positive"
+    assert user_message(UserError("-pstar must be positive")) == "-pstar must be positive"
+    with pytest.raises(UserError, match="^-E_star: must be positive$"), options_named():
+        raise ParameterError("E_star", "must be positive")

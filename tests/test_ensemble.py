@@ -39,7 +39,7 @@ def assert_same_ensemble(a, b, rtol=1e-12):
 def test_load_history_7_11_with_the_delta1_erratum():
     p = loads.history()
     assert p.shape == (95,)
-    assert p[0] == pytest.approx(0.2 / 30, rel=1e-15)          # Delta_1 = 0.2/30 (SPEC 5), not 0.067
+    assert p[0] == pytest.approx(0.2 / 30, rel=1e-15)          # Delta_1 = 0.2/30 (erratum of (7.11)), not 0.067
     assert p[29] == pytest.approx(0.2, rel=1e-15)              # end of the early stage
     assert p[30] == pytest.approx(0.2 * np.exp(0.0512), rel=1e-15)
     assert p[74] == pytest.approx(0.2 * np.exp(0.0512 * 45), rel=1e-15)
@@ -108,6 +108,18 @@ def test_file_layout_and_same_numbers_on_one_and_two_ranks(tmp_path, monkeypatch
     assert np.all(np.isfinite(c["models/complete/greenwood/A"])) and "models/early/bgt/A" not in c
     assert np.all(c["models/kappa/bem_A"][early] > 0)
     assert max(ensemble.compare(c, c).values()) == 0.0
+    # What studies read: /statistics and /models as stored, and the same numbers computed for a file without them.
+    stored = ensemble.stored_models(c)
+    assert np.array_equal(stored["complete"]["greenwood"]["A"], c["models/complete/greenwood/A"])
+    assert ensemble.stored_statistics(c)["A_mean"] is c["statistics/A_mean"]
+    unfinished = {name: value for name, value in c.items() if not name.startswith(("models", "statistics"))}
+    notes = []
+    assert np.array_equal(ensemble.stored_statistics(unfinished, notes.append)["gstar_std"], c["statistics/gstar_std"])
+    computed = ensemble.stored_models(unfinished, say=notes.append)
+    for family, model, curve in (("early", "greenwood", "A"), ("complete", "ciavarella", "gstar")):
+        assert np.array_equal(computed[family][model][curve], stored[family][model][curve], equal_nan=True)
+    assert np.array_equal(computed["kappa"]["bem_A"], c["models/kappa/bem_A"], equal_nan=True)
+    assert "statistics" in notes[0] and "no /models" in notes[-1]
     assert ensemble.compare(c, dict(c, **{"steps/A": c["steps/A"] * (1 + 1e-9)}))["steps/A"] > 1e-12
     assert_same_ensemble(contents["r1"], contents["r2"])
     assert_same_ensemble(contents["r1"], contents["g2"])

@@ -1,5 +1,5 @@
 """Penny-shaped adhesive crack (JKR, Maugis-Dugdale, full adhesion) and the
-adhesive adapted GW model (seed chapter 6)."""
+adhesive adapted GW model (the dissertation, chapter 6)."""
 
 import numpy as np
 import pytest

@@ -63,7 +63,7 @@ def test_crack_eccentricity_fit_against_root():
     y = np.logspace(-3, 0, 61)
     e = crack.e_exact(y)
     assert np.allclose(crack.ratio_from_e(e), y, rtol=1e-10)
-    # the seed's empirical fit is good to 1.5e-3 in e (worst near y = 0.8), see NOTES
+    # the dissertation's empirical fit is good to 1.5e-3 in e (worst near y = 0.8), see NOTES
     assert np.max(np.abs(crack.e_fit(y) - e)) < 2e-3
 
 

@@ -142,19 +142,20 @@ def test_load_path_reuses_the_predicted_displacement_and_certifies_every_step(pr
             target = problem.scaled_pbar(None, pstar)
             if k >= 1:
                 # The start's K p from the predictor equals a fresh K p of the start (probed on copies).
-                pressure, previous = solver.pressure, solver.previous
-                solver.pressure = pressure.copy()
-                solver.previous = previous.copy() if previous is not None else None
-                predicted = solver._load_start(target)
+                path = solver.path
+                pressure, previous = path.pressure, path.previous
+                path.pressure = pressure.copy()
+                path.previous = previous.copy() if previous is not None else None
+                predicted = path.start(target)
                 assert predicted is not None
                 fresh = problem.vec()
-                problem.operator.displacement(solver.pressure, fresh)
+                problem.operator.displacement(path.pressure, fresh)
                 scale = np.abs(problem.local(fresh)).max()
                 assert np.abs(problem.local(predicted) - problem.local(fresh)).max() <= 1e-12 * scale
-                for v in (fresh, solver.pressure, solver.previous):
+                for v in (fresh, path.pressure, path.previous):
                     if v is not None:
                         v.destroy()
-                solver.pressure, solver.previous = pressure, previous
+                path.pressure, path.previous = pressure, previous
             warm = solver.solve(pstar=pstar)
             assert warm.converged and warm.kkt.natural <= 1e-9
             cold, cold_field = solve(problem, "load", None, "fourier", 1e-9, pstar=pstar)
@@ -164,12 +165,12 @@ def test_load_path_reuses_the_predicted_displacement_and_certifies_every_step(pr
         # A certificate that fails (here forced by a perturbed stop) resumes PK to a certified result.
         backend_solve, calls = solver.backend.solve, []
 
-        def counted(target, pressure):
+        def counted(target, pressure, guess):
             calls.append(target)
-            return backend_solve(target, pressure)
+            return backend_solve(target, pressure, guess)
 
-        def perturbed(target, pressure):
-            outcome = counted(target, pressure)
+        def perturbed(target, pressure, guess):
+            outcome = counted(target, pressure, guess)
             solver.backend.solve = counted
             problem.local(pressure)[...] *= 1.0 + 1e-3 * (problem.local(problem.heights, readonly=True) > 0)
             return outcome

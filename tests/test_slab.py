@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-from roughpetsc.errors import UserError
+from roughpetsc.errors import ParameterError
 from roughpetsc.slab import SlabTransform, block_split, row_split
 from roughpetsc.surfaces import Grid
 
@@ -128,8 +128,9 @@ def test_block_split_is_balanced():
 
 
 def test_fewer_rows_than_ranks_is_refused_by_name():
-    with pytest.raises(UserError, match="-surface_N0/-surface_N"):
+    with pytest.raises(ParameterError, match="fewer than the 4 MPI ranks") as refused:
         row_split(3, 4)
+    assert refused.value.parameter == "n0"
 
 
 def test_one_rank_in_process_and_bad_sizes():

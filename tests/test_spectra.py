@@ -1,4 +1,4 @@
-"""Tests of roughpetsc.spectra against analytic moments, quadrature of (2.15)/(2.51) and the seed's tables."""
+"""Tests of roughpetsc.spectra against analytic moments, quadrature of (2.15)/(2.51) and the dissertation's tables."""
 
 import numpy as np
 import pytest
@@ -189,7 +189,7 @@ def test_bandwidth_closed_forms(k_l, k_s, hurst):
         spectra.pressure_bandwidth_from_heights(m[2], m[4], m[6]), rel=1e-12)
 
 
-# Closed-form columns of the seed (3 significant digits): Tables 7.4, 7.6, 8.2, 8.3, and alpha of 8.2/8.3.
+# Closed-form columns of the dissertation (3 significant digits): Tables 7.4, 7.6, 8.2, 8.3, and alpha of 8.2/8.3.
 SEED_CLOSED = [
     # (k_l, k_s, H, m0h, m4h, m6h, m2p, m4p, alpha_h, alpha_p)
     (16, 64, 0.8, 1.19e-8, 9.16, 6.97e5, 3.05, 2.09e5, None, None),
@@ -213,7 +213,7 @@ def test_closed_forms_reproduce_seed_tables(k_l, k_s, hurst, m0h, m4h, m6h, m2p,
         assert forms["alpha_p"] == pytest.approx(alpha_p, rel=5e-3)
 
 
-# --- generated surfaces: the seed's "Num" columns ---------------------------------
+# --- generated surfaces: the dissertation's "Num" columns ---------------------------------
 
 def ensemble_summaries(k_l, k_s, hurst, n, seeds):
     grid = Grid(n, n, 1.0, 1.0)

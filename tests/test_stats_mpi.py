@@ -8,6 +8,10 @@ import sys
 import numpy as np
 import pytest
 
+from conftest import run_cli
+from roughpetsc import ensemble, seeds
+from roughpetsc.store import stats_file
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PYTHON = "/usr/bin/python3"
 
@@ -25,8 +29,9 @@ except UserError as error:
     sys.exit(2)
 """
 
-SMALL_GROUP = ["-surface_N", "128", "-surface_kl", "4", "-surface_ks", "16", "-surface_H", "0.8",
-               "-surface_m2", "2e-4", "-surface_seed", "11"]
+SURFACE = ["-surface_N", "128", "-surface_kl", "4", "-surface_ks", "16", "-surface_H", "0.8", "-surface_m2", "2e-4"]
+SMALL_GROUP = SURFACE + ["-surface_seed", "11"]     # one surface
+ENSEMBLE = SURFACE + ["-ensemble_seed", "11"]       # realisations i: seeds.surface_seed(11, i)
 
 def run_stats(ranks, arguments, tmp_path):
     environment = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
@@ -45,10 +50,10 @@ def stats_json(ranks, arguments, tmp_path):
 
 
 def test_ensemble_on_two_ranks_equals_one_rank(tmp_path):
-    arguments = SMALL_GROUP + ["-stats_ensemble", "5"]
+    arguments = ENSEMBLE + ["-stats_ensemble", "5"]
     one, _ = stats_json(1, arguments, tmp_path)
     two, stdout = stats_json(2, arguments, tmp_path)
-    assert one["seeds"] == two["seeds"] == [11, 12, 13, 14, 15]
+    assert one["seeds"] == two["seeds"] == seeds.surface_seeds(11, 5)
     assert one["per_surface"] == two["per_surface"]          # bit-identical, seed order
     assert one["mean"] == two["mean"]
     assert one["std"] == two["std"]
@@ -77,20 +82,23 @@ def test_hdf5_and_plots_are_written(tmp_path):
 
     h5 = tmp_path / "s.h5"
     prefix = tmp_path / "pdf"
-    result = run_stats(2, SMALL_GROUP + ["-stats_ensemble", "3", "-stats_h5", str(h5), "-stats_plot", str(prefix),
-                                         "-E_star", "2.0"], tmp_path)
+    result = run_stats(2, ENSEMBLE + ["-stats_ensemble", "3", "-stats_h5", str(h5), "-stats_plot", str(prefix),
+                                      "-E_star", "2.0"], tmp_path)
     assert result.returncode == 0, result.stderr
     with h5py.File(h5, "r") as f:
         assert json.loads(f.attrs["settings"])["e_star"] == 2.0
         assert f.attrs["surface_options.surface_N"] == 128
         assert "numpy" in json.loads(f.attrs["versions"])
-        assert list(f["seeds"][()]) == [11, 12, 13]
+        assert list(f["seeds"][()]) == seeds.surface_seeds(11, 3)
         m0p = f["per_surface/m0p_fd"][()]
         assert m0p.shape == (3,)
         assert f["mean"].attrs["m0p_fd"] == pytest.approx(np.mean(m0p), rel=1e-15)
         assert f["std"].attrs["m0p_fd"] == pytest.approx(np.std(m0p, ddof=1), rel=1e-12)
     assert (tmp_path / "pdf_h.png").stat().st_size > 0 and (tmp_path / "pdf_p.png").stat().st_size > 0
     assert not [p for p in os.listdir(tmp_path) if ".tmp-" in p]
+    stored = stats_file.read(h5)                             # the reader of the file kind
+    assert stored["seeds"] == seeds.surface_seeds(11, 3) and stored["settings"]["e_star"] == 2.0
+    assert np.array_equal(stored["per_surface"]["m0p_fd"], m0p)
 
 
 def test_e_star_scales_pressure_moments(tmp_path):
@@ -110,6 +118,7 @@ def test_e_star_scales_pressure_moments(tmp_path):
     (["-stats_json", "/nonexistent-folder/x.json"], "-stats_json"),
     (["-surface_ks", "100"], "-surface_ks"),
     (["-surface_type", "wave", "-stats_ensemble", "2"], "-stats_ensemble"),
+    (["-stats_ensemble", "2"], "-surface_seed"),       # an ensemble's seeds derive from -ensemble_seed
 ])
 def test_bad_input_names_the_option_on_two_ranks(tmp_path, arguments, option):
     result = run_stats(2, SMALL_GROUP + arguments, tmp_path)
@@ -117,3 +126,69 @@ def test_bad_input_names_the_option_on_two_ranks(tmp_path, arguments, option):
     assert option in result.stderr
     assert "Traceback" not in result.stderr
     assert not list(tmp_path.glob("*.json"))
+
+
+def test_one_master_seed_means_one_surface_in_stats_and_ensemble_modes(tmp_path):
+    """(master seed, index) -> one surface: -mode stats and -mode ensemble, on 1 and 2 ranks."""
+    surface = ["-surface_N", "64", "-surface_kl", "4", "-surface_ks", "16", "-ensemble_seed", "7"]
+    one, _ = stats_json(1, surface + ["-stats_ensemble", "3"], tmp_path)
+    two, _ = stats_json(2, surface + ["-stats_ensemble", "3"], tmp_path)
+    path = tmp_path / "e.h5"
+    out = run_cli(["-mode", "ensemble", *surface, "-ensemble_size", 3, "-ensemble_loads", "0.1",
+                   "-ensemble_models", "none", "-output", path], ranks=2)
+    assert out.returncode == 0, out.stderr
+    stored = ensemble.read(path)
+    assert one["seeds"] == two["seeds"] == list(stored["surfaces/seed"]) == seeds.surface_seeds(7, 3)
+    assert one["per_surface"] == two["per_surface"]
+    # The same heights give the same spectral moments (2.12) and finite-difference bandwidths (7.6)/(7.7).
+    for stats_name, ensemble_name in (("m0h_spec", "m0h"), ("m2h_spec", "m2h"), ("m4h_spec", "m4h"),
+                                      ("m2p_spec", "m2p"), ("alpha_h_spectral", "alpha_h"),
+                                      ("alpha_p_spectral", "alpha_p"), ("alpha_h", "alpha_h_fd"),
+                                      ("alpha_p", "alpha_p_fd")):
+        assert one["per_surface"][stats_name] == list(stored[f"surfaces/{ensemble_name}"]), stats_name
+
+
+ONE_RANK_FAILS = """
+import sys, petsc4py
+petsc4py.init(sys.argv)
+from petsc4py import PETSc
+from mpi4py import MPI
+from roughpetsc import stats_mode
+from roughpetsc.errors import ParameterError, UserError
+
+compute_one = stats_mode.surface_statistics
+
+
+def fails_on_rank_1(grid, heights, settings, edges):
+    if MPI.COMM_WORLD.rank == 1:  # a library error on one rank only: the other must not wait for it
+        raise ParameterError("k_s", "must lie below the Nyquist wavenumber")
+    return compute_one(grid, heights, settings, edges)
+
+
+stats_mode.surface_statistics = fails_on_rank_1
+try:
+    stats_mode.run(PETSc.Options(), MPI.COMM_WORLD)
+except UserError as error:
+    # One file per rank: two ranks printing to one stdout interleave.
+    import os
+    with open(f"{os.environ['ONE_RANK_FAILS_OUT']}.rank{MPI.COMM_WORLD.rank}", "w") as out:
+        out.write(str(error))
+    sys.exit(2)
+"""
+
+
+def test_a_library_error_on_one_rank_stops_every_rank(tmp_path):
+    """A ParameterError raised on rank 1 alone is every rank's UserError naming the option (no rank hangs)."""
+    driver = tmp_path / "one_rank_fails.py"
+    driver.write_text(ONE_RANK_FAILS)
+    environment = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+                       PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""),
+                       ONE_RANK_FAILS_OUT=str(tmp_path / "error"))
+    command = ["mpiexec", "-n", "2", "--oversubscribe", PYTHON, str(driver), "-surface_N", "32",
+               "-surface_kl", "2", "-surface_ks", "8", "-ensemble_seed", "3", "-stats_ensemble", "2"]
+    result = subprocess.run(command, capture_output=True, text=True, env=environment, timeout=60, cwd=ROOT)
+    assert result.returncode == 2, result.stderr
+    for rank in (0, 1):  # the message of rank 1's error, raised on both ranks
+        message = (tmp_path / f"error.rank{rank}").read_text()
+        assert message == "-surface_ks: must lie below the Nyquist wavenumber"
+    assert "Traceback" not in result.stderr

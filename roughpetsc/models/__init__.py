@@ -1,6 +1,6 @@
-"""Statistical contact models of the seed (chapters 2.5, 4, 5, 6, 8; appendices D, E).
+"""Statistical contact models of the dissertation (chapters 2.5, 4, 5, 6, 8; appendices D, E).
 
-Dimensionless conventions (SPEC section 1): separation ``d* = d / sqrt(m0^h)``,
+Dimensionless conventions (docs/conventions.md): separation ``d* = d / sqrt(m0^h)``,
 pressure ``p* = pbar / sqrt(m0^p) = pbar / (E* sqrt(m2^h / 2))``, mean gap
 ``g* = gbar / sqrt(m0^h)``, contact ratio ``A*``; bandwidths ``alpha^h`` (2.16)
 and ``alpha^p`` (2.54).
@@ -29,13 +29,13 @@ from .adhesion import (AdhesiveCrack, AdhesiveGW, jkr_G, jkr_pmin, jkr_pstar,
                        nonadhesive_radius, nonadhesive_volume)
 from .complete import COMPLETE_MODELS, complete
 from .curvefit import ALPHA_P_TABLE_8_3, TABLE_8_4, correction, curvefit_area, fit_curvefit
-from .early import EARLY_MODELS, early, early_area, early_separation
+from .early import EARLY_MODELS, TABLE_4_1, TABLE_4_1_SEPARATIONS, early, early_area, early_separation
 from .persson import fractal_moments, persson_area, persson_gap, psd_amplitude
 
 __all__ = ["early", "early_area", "early_separation", "complete", "persson_area",
            "persson_gap", "psd_amplitude", "fractal_moments", "curvefit_area",
            "fit_curvefit", "correction", "TABLE_8_4", "ALPHA_P_TABLE_8_3",
-           "EARLY_MODELS", "COMPLETE_MODELS", "hertz", "crack", "pdfs", "quadrature",
+           "EARLY_MODELS", "TABLE_4_1", "TABLE_4_1_SEPARATIONS", "COMPLETE_MODELS", "hertz", "crack", "pdfs", "quadrature",
            "AdhesiveCrack", "AdhesiveGW", "jkr_pstar", "jkr_pmin", "jkr_radius",
            "jkr_G", "jkr_volume", "nonadhesive_radius", "nonadhesive_area",
            "nonadhesive_volume"]

@@ -1,4 +1,4 @@
-"""Penny-shaped adhesive crack and the adhesive adapted GW model (seed chapter 6).
+"""Penny-shaped adhesive crack and the adhesive adapted GW model (the dissertation, chapter 6).
 
 Dimensionless groups of Eqs. (6.4)-(6.6): ``p* = p0 / P``, ``b* = b / L``,
 ``m = c / b``, ``G* = G / w``, ``A* = A / L^2``, ``V* = V / (3 w / (2 kappa))``,

@@ -1,5 +1,5 @@
 """Integrals over summit height and curvature shared by all multi-asperity and
-multi-crack models (seed Eqs. (4.21)-(4.31), (5.35)-(5.46)).
+multi-crack models (the dissertation, Eqs. (4.21)-(4.31), (5.35)-(5.46)).
 
 Every model of chapters 4 and 5 is a sum of terms
 

@@ -1,4 +1,4 @@
-"""Statistical models of nearly complete contact (seed chapter 5.3).
+"""Statistical models of nearly complete contact (the dissertation, chapter 5.3).
 
 Dimensionless variables: ``p* = pbar / sqrt(m0^p)``, mean gap
 ``g* = gbar / sqrt(m0^h)``, contact ratio ``A*``.  The models are the

@@ -1,4 +1,4 @@
-"""Pressurised elliptical and penny-shaped cracks (seed section 5.2).
+"""Pressurised elliptical and penny-shaped cracks (the dissertation, section 5.2).
 
 A non-contact island of the nearly complete contact is a crack loaded by
 p2 = p0 - kappa_1 x^2/2 - kappa_2 y^2/2 (5.4).  Units: p0 and E* [pressure],
@@ -9,7 +9,7 @@ volume [length^3].
 import numpy as np
 from scipy.special import ellipe, ellipk
 
-from .ellipse import elliptic_KE, fit_sqrt1me2, invert_ratio
+from .ellipse import elliptic_KE, fit_sqrt1me2, invert_ratio, ratio_of_eccentricity
 
 __all__ = ["ratio_from_e", "e_exact", "e_fit", "I00", "I02", "I22", "F1", "F2",
            "elliptical", "penny", "mildly_elliptical_geometric", "mildly_elliptical_mean"]
@@ -23,9 +23,7 @@ def _ratio_of_z(z):
 
 def ratio_from_e(e):
     """Curvature ratio kappa_1^p/kappa_2^p of a crack of eccentricity e, Eq. (5.15)."""
-    e = np.asarray(e, dtype=float)
-    z = np.log1p(-e ** 2)
-    return np.where(e == 0, 1.0, _ratio_of_z(np.where(e == 0, -1.0, z)))
+    return ratio_of_eccentricity(_ratio_of_z, e)
 
 
 def e_exact(ratio):
@@ -65,7 +63,7 @@ def I22(e):
 def F1(e, ratio):
     """Area correction F1 of Eq. (5.18), as printed.
 
-    Omega = I00 I22 - I02 I20 needs I_20^c, which the seed does not define; with
+    Omega = I00 I22 - I02 I20 needs I_20^c, which the dissertation does not define; with
     Martin's symmetric definition I_20^c = I_02^c it is used here.  (Eliminating
     B2 = 0 from (5.8) and (5.14) gives I02^2 instead of the printed I02 in the
     bracket; see the study report.)"""

@@ -1,8 +1,8 @@
-"""Complete-contact curve fit of A*(p*) (seed 8.5, Eqs. (8.2)-(8.3), Table 8.4).
+"""Complete-contact curve fit of A*(p*) (the dissertation, 8.5, Eqs. (8.2)-(8.3), Table 8.4).
 
 A*(p*) = I(p*) f(p*) for p* <= 2 and I(p*) beyond, where I is the Greenwood
 nearly-complete model (5.45) and f(p*) = a exp(b p*) + c exp(d p*) with a = -c
-(so that A*(0) = 0; SPEC erratum: the sentence after Table 8.4 gives the column
+(so that A*(0) = 0; erratum of docs/conventions.md: the sentence after Table 8.4 gives the column
 means of b, c, d under the names a, b, c).  Continuity at p* = 2 requires
 c = 1 / (exp(2 d) - exp(2 b)).
 """
@@ -58,7 +58,7 @@ def curvefit_area(pstar, alpha_p, b, c, d):
 def fit_curvefit(pstar, area, alpha_p, guess=(-1.9, -0.05)):
     """Fit b, c, d of (8.2)-(8.3) to a curve A*(p*) (e.g. a BEM ensemble mean).
 
-    The seed's two boundary conditions are built in: a = -c (A*(0) = 0) and
+    The dissertation's two boundary conditions are built in: a = -c (A*(0) = 0) and
     c = 1 / (exp(2d) - exp(2b)) (continuity at p* = 2); b and d are found by
     least squares over the points with p* <= 2.
 

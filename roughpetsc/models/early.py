@@ -1,4 +1,4 @@
-"""Statistical models of early contact (seed chapter 4).
+"""Statistical models of early contact (the dissertation, chapter 4).
 
 Dimensionless variables: separation ``d* = d / sqrt(m0^h)``, pressure
 ``p* = pbar / sqrt(m0^p) = pbar / (E* sqrt(m2^h / 2))``, contact ratio ``A*``.
@@ -11,9 +11,30 @@ from scipy.special import erfc, erfcinv
 from . import hertz
 from .asperity import CurvatureRule, height_integrals
 
-__all__ = ["EARLY_MODELS", "early", "early_area", "early_separation"]
+__all__ = ["EARLY_MODELS", "TABLE_4_1", "TABLE_4_1_SEPARATIONS", "early", "early_area", "early_separation"]
 
 EARLY_MODELS = ("gw", "nayak_bush", "greenwood", "bgt", "bgt_asymptotic")
+
+TABLE_4_1_SEPARATIONS = np.array([0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0])
+# Tables 4.1/4.2, the "Dissertation" columns: (A*, sqrt(pi/2) p*) at the separations d* above, by
+# (model, alpha^h).
+TABLE_4_1 = {
+    ("bgt", 2.0): ([1.644e-1, 1.080e-1, 6.039e-2, 2.750e-2, 9.940e-3, 2.824e-3, 6.301e-4],
+                   [2.270e-1, 1.368e-1, 7.102e-2, 3.060e-2, 1.066e-2, 2.962e-3, 6.519e-4]),
+    ("greenwood", 2.0): ([1.674e-1, 1.098e-1, 6.129e-2, 2.785e-2, 1.004e-2, 2.848e-3, 6.341e-4],
+                         [2.218e-1, 1.339e-1, 6.967e-2, 3.010e-2, 1.052e-2, 2.931e-3, 6.463e-4]),
+    ("bgt", 10.0): ([2.040e-1, 1.174e-1, 5.809e-2, 2.415e-2, 8.269e-3, 2.297e-3, 5.120e-4],
+                    [3.680e-1, 1.950e-1, 8.940e-2, 3.471e-2, 1.120e-2, 2.956e-3, 6.308e-4]),
+    # Table 4.1 prints 8.403e-2 for Greenwood, alpha 10, d* = 2: the exponent is an
+    # obvious typo (the [16] column and the monotone column say 8.403e-3).
+    ("greenwood", 10.0): ([2.079e-1, 1.195e-1, 5.912e-2, 2.456e-2, 8.403e-3, 2.333e-3, 5.194e-4],
+                          [3.588e-1, 1.902e-1, 8.730e-2, 3.393e-2, 1.096e-2, 2.896e-3, 6.188e-4]),
+    ("nayak_bush", 2.0): ([1.449e-1, 9.593e-2, 5.425e-2, 2.507e-2, 9.210e-3, 2.657e-3, 6.003e-4],
+                          [2.089e-1, 1.266e-1, 6.624e-2, 2.881e-2, 1.014e-2, 2.844e-3, 6.307e-4]),
+    ("nayak_bush", 10.0): ([1.785e-1, 1.030e-1, 5.121e-2, 2.139e-2, 7.367e-3, 2.059e-3, 4.617e-4],
+                           [3.361e-1, 1.785e-1, 8.209e-2, 3.198e-2, 1.036e-2, 2.745e-3, 5.883e-4]),
+}
+
 _KIND = {"gw": "xi", "nayak_bush": "km", "greenwood": "kg", "bgt": "k1k2"}
 
 
@@ -70,7 +91,7 @@ def early(name, dstar, alpha_h, elements=None, e_method="exact"):
         Gauss-Legendre elements per dimension (accuracy control).
     e_method : {"exact", "fit"}
         BGT only: eccentricity from the exact root of (4.10) (default; it
-        reproduces Table 4.1) or from the fit (4.11) that the seed mentions
+        reproduces Table 4.1) or from the fit (4.11) that the dissertation mentions
         below (4.31) (differs by up to ~2e-5 relative).
 
     Returns

@@ -9,7 +9,7 @@ by a vectorised bisection in ``z = ln(1 - e^2)``.
 import numpy as np
 from scipy.special import ellipe, ellipkm1
 
-__all__ = ["elliptic_KE", "invert_ratio", "fit_sqrt1me2"]
+__all__ = ["elliptic_KE", "ratio_of_eccentricity", "invert_ratio", "fit_sqrt1me2"]
 
 
 def elliptic_KE(z):
@@ -18,6 +18,13 @@ def elliptic_KE(z):
     ``ellipkm1`` keeps K accurate as e -> 1 (scipy uses the parameter m = e^2)."""
     p = np.exp(z)                      # 1 - e^2
     return ellipkm1(p), ellipe(1.0 - p), p
+
+
+def ratio_of_eccentricity(ratio_of_z, e):
+    """The curvature ratio ``ratio_of_z(ln(1 - e^2))`` at eccentricity ``e``; 1 for the circle e = 0."""
+    e = np.asarray(e, dtype=float)
+    z = np.log1p(-e ** 2)
+    return np.where(e == 0, 1.0, ratio_of_z(np.where(e == 0, -1.0, z)))
 
 
 def invert_ratio(ratio_of_z, ratio, z_min=-80.0, iterations=80):

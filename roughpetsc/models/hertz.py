@@ -1,4 +1,4 @@
-"""Hertz contact of one parabolic asperity (seed section 4.2).
+"""Hertz contact of one parabolic asperity (the dissertation, section 4.2).
 
 Units: penetration ``delta`` [length], curvatures [1/length], ``E_star`` [pressure];
 area [length^2], load [force].
@@ -7,7 +7,7 @@ area [length^2], load [force].
 import numpy as np
 from scipy.special import ellipe, ellipk
 
-from .ellipse import elliptic_KE, fit_sqrt1me2, invert_ratio
+from .ellipse import elliptic_KE, fit_sqrt1me2, invert_ratio, ratio_of_eccentricity
 
 __all__ = ["ratio_from_e", "e_exact", "e_fit", "F1", "F2", "elliptical",
            "circular", "mildly_elliptical_geometric", "mildly_elliptical_mean"]
@@ -20,9 +20,7 @@ def _ratio_of_z(z):
 
 def ratio_from_e(e):
     """Curvature ratio kappa_1/kappa_2 of a Hertz contact of eccentricity e, Eq. (4.10)."""
-    e = np.asarray(e, dtype=float)
-    z = np.log1p(-e ** 2)
-    return np.where(e == 0, 1.0, _ratio_of_z(np.where(e == 0, -1.0, z)))
+    return ratio_of_eccentricity(_ratio_of_z, e)
 
 
 def e_exact(ratio):

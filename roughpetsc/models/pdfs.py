@@ -1,4 +1,4 @@
-"""Asperity probability densities of an isotropic Gaussian surface (seed 2.5, 7.2.2).
+"""Asperity probability densities of an isotropic Gaussian surface (the dissertation, 2.5, 7.2.2).
 
 All densities are in the dimensionless variables of Eq. (2.34): summit height
 ``xi = xi^h / sqrt(m0)`` and curvatures ``kappa = kappa^h / sqrt(m4)``; they are

@@ -1,8 +1,14 @@
-"""Persson's model (seed 5.4 and appendix E)."""
+"""Persson's model (the dissertation, section 5.4 and appendix E).
+
+``psd_amplitude`` is the amplitude C of the PSD (2.18) from m2^h, eq. (7.1):
+:func:`roughpetsc.surfaces.fractal_amplitude`, re-exported here under the name the models use.
+"""
 
 import numpy as np
 from scipy.special import erf, exp1
 
+from ..spectra import fractal_height_moment
+from ..surfaces import fractal_amplitude as psd_amplitude
 from .quadrature import gauss_legendre
 
 __all__ = ["persson_area", "persson_gap", "psd_amplitude", "fractal_moments"]
@@ -14,22 +20,9 @@ def persson_area(pstar):
     return erf(np.asarray(pstar, dtype=float) / np.sqrt(2.0))
 
 
-def psd_amplitude(k_l, k_s, H, m2):
-    """PSD amplitude C of (2.18) with k_r = k_l from the slope moment m2, Eq. (7.1):
-    C = 4 (1 - H) m2 / ((2 pi)^3 (k_s^(2-2H) - k_l^(2-2H)))  [length^(4-2H)]."""
-    return 4.0 * (1.0 - H) * m2 / ((2.0 * np.pi) ** 3 * (k_s ** (2 - 2 * H) - k_l ** (2 - 2 * H)))
-
-
 def fractal_moments(k_l, k_s, H, C):
-    """Moments m0, m2, m4, m6 of the PSD (2.18) with k_r = k_l, Eq. (2.20)."""
-    out = []
-    coef = 1.0
-    for n in (0, 2, 4, 6):
-        if n:
-            coef *= (n - 1.0) / n
-        out.append(coef * (2 * np.pi) ** (n + 1) * C / (n - 2 * H)
-                   * (k_s ** (n - 2 * H) - k_l ** (n - 2 * H)))
-    return tuple(out)
+    """Moments m0, m2, m4, m6 of the PSD (2.18) with k_r = k_l, Eq. (2.20) (:func:`roughpetsc.spectra.fractal_height_moment`)."""
+    return tuple(fractal_height_moment(n, k_l, k_s, H, C) for n in (0, 2, 4, 6))
 
 
 def persson_gap(pstar, k_l, k_s, H, m2, E_star, gamma=1.0, n_elements=32, order=8):

@@ -1,7 +1,7 @@
-"""One shared, vectorised composite Gauss-Legendre rule (seed section 4.4).
+"""One shared, vectorised composite Gauss-Legendre rule (the dissertation, section 4.4).
 
 Every integral of the statistical models is evaluated with :func:`gauss_legendre`
-on a finite, transformed domain.  The seed (section 4.4) maps the semi-infinite
+on a finite, transformed domain.  The dissertation (section 4.4) maps the semi-infinite
 summit-height range with ``x = 1/xi`` and the curvature ranges with
 ``y = exp(-kappa)``.  Two refinements of the same idea are used here:
 
@@ -9,7 +9,7 @@ summit-height range with ``x = 1/xi`` and the curvature ranges with
   and leaves the endpoint singularities ``(xi - d)**(3/2)``, ``(xi - d)**(5/2)``
   and ``kappa**(1/2)`` in the integrand.  :func:`semi_infinite` therefore uses the
   algebraic map ``t = scale * ((1 - u) / u)**power`` with ``u`` in ``(0, 1]``
-  (``power = 1`` is the seed's ``x = 1/xi`` shifted to the lower limit;
+  (``power = 1`` is the dissertation's ``x = 1/xi`` shifted to the lower limit;
   ``power = 2`` additionally makes every half-integer power of ``t`` smooth in
   ``u``), so that Gauss-Legendre converges exponentially.
 * The curvature ratio ``y = kappa_1/kappa_2`` of the BGT model carries a
@@ -40,7 +40,7 @@ def gauss_legendre(n_elements, order=8, a=0.0, b=1.0):
     n_elements : int
         Number of equal elements (the accuracy control, Eqs. (4.36)-(4.38)).
     order : int
-        Gauss points per element (the seed uses 4).
+        Gauss points per element (the dissertation uses 4).
     a, b : float
         Interval limits.
 

@@ -1,4 +1,4 @@
-"""Polonsky-Keer constrained conjugate gradients, as a TAO ``python`` type.
+"""Polonsky-Keer constrained conjugate gradients, the context of a TAO of type ``python``.
 
 Polonsky and Keer, Wear 231 (1999): CG on the contact set with the mean gap
 there removed (which fixes the rigid separation), projection onto p >= 0 and
@@ -32,17 +32,19 @@ under PK, the entry of nodes) changed nothing, and recomputed with a fresh
 ``K p`` otherwise, every ``-pk_refresh`` iterations, and before convergence is
 declared (the stopping rule is always checked on a freshly computed gap).
 
-The stopping rule is the natural KKT residual of :mod:`roughpetsc.kkt`.
+The stopping rule is the natural KKT residual of :mod:`roughpetsc.kkt` (docs/conventions.md).
 ``tao.monitor`` is called every iteration so that ``-tao_monitor`` and Python
-monitors work.
+monitors work. The backend that drives this context along load paths is
+:mod:`roughpetsc.solvers.pk`.
 """
 
 import numpy as np
 from petsc4py import PETSc
 
-from .errors import UserError
-from .kkt import STAGNATION_ITERATIONS, History, allsum, report
-from .preconditioner import FourierPreconditioner
+from ..errors import UserError
+from ..kkt import STAGNATION_ITERATIONS, History, allsum, report
+from ..preconditioner import FourierPreconditioner
+from .tao_options import option_name
 
 PRECONDITIONERS = ("none", "fourier")
 ACTIVE_SETS = ("pk", "bccg")
@@ -56,12 +58,20 @@ class PolonskyKeer:
     (displacement control, scaled rigid separation d): then the same projected
     CG runs with d fixed, no mean removal and no rescaling.
 
-    Options (read by :meth:`configure`): ``-pk_pc none|fourier``,
+    Options (read by :meth:`setFromOptions` under the TAO's prefix): ``-pk_pc none|fourier``,
     ``-pk_active_set bccg|pk`` and ``-pk_refresh N`` (recompute ``K p`` at
     least every N iterations).
+
+    Parameters
+    ----------
+    problem : ContactProblem
+    rtol : float
+        Tolerance on the natural KKT residual (and the load error under load control).
+    max_seconds : float
+        Seconds after which a solve stops with DIVERGED_USER (0: no limit).
     """
 
-    def __init__(self, problem, rtol):
+    def __init__(self, problem, rtol, max_seconds=0.0):
         self.problem = problem
         self.rtol = rtol
         self.target_pbar = None
@@ -70,12 +80,13 @@ class PolonskyKeer:
         self.preconditioner = "fourier"
         self.refresh = 50
         self.active_set = "bccg"
-        self.max_seconds = 0.0
+        self.max_seconds = max_seconds
+        self.option_error = None  # what setFromOptions refused, raised by the caller after it returns
         self.history = None
         # K p of the start, if the caller knows it (then the first fresh K p is skipped); cleared by solve.
         self.initial_displacement = None
         # False: a residual below rtol on the updated (not fresh) gap ends the solve, unconfirmed; the caller
-        # must then certify on a fresh gap and resume if that fails (Solver does, in _result).
+        # must then certify on a fresh gap and resume if that fails (the Solver facade does).
         self.confirm = True
         self.unconfirmed = False
         self.best_natural = np.inf  # the lowest natural residual of the last solve
@@ -83,24 +94,32 @@ class PolonskyKeer:
         self.vecs = [problem.vec() for _ in range(6)]
         self.fourier = FourierPreconditioner(problem)
 
-    def configure(self):
-        """Read ``-pk_pc``, ``-pk_active_set`` and ``-pk_refresh``.
+    def setFromOptions(self, tao):
+        """Read ``-pk_pc``, ``-pk_active_set`` and ``-pk_refresh`` under the TAO's options prefix.
 
-        Called before the TAO is set up: an exception raised inside a TAO
-        callback would leave PETSc's options block open and crash at exit.
+        Called by ``tao.setFromOptions()``. A refused value is kept in :attr:`option_error` (a
+        :class:`UserError`) for the caller to raise once ``setFromOptions`` has returned: an
+        exception raised inside this callback would leave PETSc's options block open.
         """
-        options = PETSc.Options()
+        prefix = tao.getOptionsPrefix()
+        options = PETSc.Options(prefix)
         self.preconditioner = options.getString("pk_pc", self.preconditioner)
-        if self.preconditioner not in PRECONDITIONERS:
-            raise UserError(f"-pk_pc: unknown preconditioner '{self.preconditioner}' "
-                            f"(one of {', '.join(PRECONDITIONERS)})")
-        self.refresh = options.getInt("pk_refresh", self.refresh)
         self.active_set = options.getString("pk_active_set", self.active_set)
-        if self.active_set not in ACTIVE_SETS:
-            raise UserError(f"-pk_active_set: unknown strategy '{self.active_set}' "
-                            f"(one of {', '.join(ACTIVE_SETS)})")
-        if self.refresh < 1:
-            raise UserError(f"-pk_refresh must be a positive number of iterations, got {self.refresh}")
+        try:
+            self.refresh = options.getInt("pk_refresh", self.refresh)
+        except PETSc.Error:
+            self.option_error = UserError(f"{option_name('pk_refresh', prefix)}: cannot read the value "
+                                          f"'{options.getString('pk_refresh', '')}' as an integer")
+            return
+        if self.preconditioner not in PRECONDITIONERS:
+            self.option_error = UserError(f"{option_name('pk_pc', prefix)}: unknown preconditioner "
+                                          f"'{self.preconditioner}' (one of {', '.join(PRECONDITIONERS)})")
+        elif self.active_set not in ACTIVE_SETS:
+            self.option_error = UserError(f"{option_name('pk_active_set', prefix)}: unknown strategy "
+                                          f"'{self.active_set}' (one of {', '.join(ACTIVE_SETS)})")
+        elif self.refresh < 1:
+            self.option_error = UserError(f"{option_name('pk_refresh', prefix)} must be a positive number of "
+                                          f"iterations, got {self.refresh}")
 
     def view(self, tao, viewer):
         viewer.printfASCII(f"  Polonsky-Keer CG, active set {self.active_set}, preconditioner "
@@ -132,6 +151,7 @@ class PolonskyKeer:
         z = problem.local(self.vecs[4]).ravel()  # preconditioned residual
         r_old = problem.local(self.vecs[5]).ravel()
         r_old[...] = 0.0
+        upper = problem.upper_bound
         bccg = self.active_set == "bccg"
         precondition = self.preconditioner == "fourier"
         contact = np.empty_like(p)  # 1.0 on the contact set, 0.0 elsewhere: masks as dot products
@@ -141,7 +161,6 @@ class PolonskyKeer:
             self.separation = self.target_separation
             self._interference_start(pressure, p, h)
         self.history = History(problem)
-        self.restarts = 0  # CG restarts: PK, nodes entered the contact set; BCCG, Polak-Ribiere beta <= 0
         max_it = tao.getMaximumIterations()
         rz_old, conjugate, fresh_needed = 1.0, False, True
         since_fresh = 0
@@ -158,13 +177,16 @@ class PolonskyKeer:
                 since_fresh, fresh_needed = 0, False
             fresh = since_fresh == 0
             np.greater(p, 0.0, out=contact)
+            if upper is not None:
+                np.copyto(contact, 0.0, where=p >= upper)  # plastic nodes: their gap may be negative
             np.subtract(displacement, h, out=gap)
             if load_control:
-                # d is fixed by a zero mean gap on the contact set: g = K p - h + d.
+                # d is fixed by a zero mean gap on the (elastic) contact set: g = K p - h + d.
                 count, gap_sum = allsum(mpi, [contact.sum(), np.dot(gap, contact)])
-                self.separation = -gap_sum / count
+                if count:  # (a fully plastic contact keeps the last d)
+                    self.separation = -gap_sum / count
             gap += self.separation
-            kkt = report(mpi, p, gap, n, pbar)
+            kkt = report(mpi, p, gap, n, pbar, upper)
             converged = kkt.natural <= self.rtol and (kkt.load_error is None or kkt.load_error <= self.rtol)
             if converged and not fresh and self.confirm:
                 fresh_needed = True  # confirm on a freshly computed K p before stopping
@@ -189,7 +211,12 @@ class PolonskyKeer:
             # The free set: the contact set, and under BCCG also the nodes out of contact that overlap.
             if bccg:
                 np.less(gap, 0.0, out=negative)
+                if upper is not None:
+                    negative &= p < upper
                 np.copyto(contact, 1.0, where=negative)
+            if upper is not None:
+                # Plastic nodes whose gap opens leave the cap: they join the free set.
+                np.copyto(contact, 1.0, where=(p >= upper) & (gap > 0.0))
             if bccg or not load_control:
                 count, gap_sum = allsum(mpi, [contact.sum(), np.dot(gap, contact)])
             else:
@@ -209,9 +236,7 @@ class PolonskyKeer:
             if bccg:
                 # Polak-Ribiere (clipped at 0): conjugacy survives changes of the free set.
                 rz, r_old_z = allsum(mpi, [np.dot(r, direction), np.dot(r_old, direction)])
-                beta = (rz - r_old_z) / rz_old if iteration else 0.0
-                self.restarts += iteration > 0 and beta <= 0.0
-                beta = max(beta, 0.0)
+                beta = max((rz - r_old_z) / rz_old if iteration else 0.0, 0.0)
                 np.copyto(r_old, r)
             else:
                 rz, = allsum(mpi, [np.dot(r, direction)])
@@ -238,6 +263,9 @@ class PolonskyKeer:
             # Projection onto p >= 0; under PK, nodes out of contact that overlap enter and CG restarts.
             clipped = np.count_nonzero(np.less(p, 0.0, out=negative))
             np.maximum(p, 0.0, out=p)
+            if upper is not None:
+                clipped += np.count_nonzero(p > upper)
+                np.minimum(p, upper, out=p)
             if bccg:
                 changed, = allsum(mpi, [clipped])
                 entering = 0
@@ -249,13 +277,22 @@ class PolonskyKeer:
                     np.multiply(gap, -step, out=response)
                     np.copyto(p, response, where=overlap)
                 conjugate = entering == 0
-                self.restarts += not conjugate
-            if load_control:
+            fresh_needed = bool(changed or entering)
+            if load_control and upper is None:
                 total, = allsum(mpi, [p.sum()])
                 scale = pbar * n / total
                 p *= scale
                 displacement *= scale
-            fresh_needed = bool(changed or entering)
+            elif load_control:
+                # Directions keep the load on the free set: it drifts where the projection clipped (then
+                # K p is computed afresh anyway) and slowly otherwise; a drift well inside the tolerance is
+                # left for later, as rescaling beside capped nodes costs a fresh K p.
+                total, = allsum(mpi, [p.sum()])
+                if changed or abs(total - pbar * n) > 0.01 * self.rtol * pbar * n:
+                    fresh_needed |= self._restore_load_below_cap(p, displacement, pbar * n, upper)
+                    if self.stopped_by:
+                        reason = PETSc.TAO.Reason.DIVERGED_USER
+                        break
             since_fresh += 1
             iteration += 1
             tao.setIterationNumber(iteration)
@@ -279,3 +316,42 @@ class PolonskyKeer:
         interference, energy = allsum(problem.mpi, [np.dot(p, p), np.dot(p, response)])
         if energy > 0:
             p *= interference / energy
+        if problem.upper_bound is not None:
+            np.minimum(p, problem.upper_bound, out=p)
+
+    def _restore_load_below_cap(self, p, displacement, total_load, upper):
+        """Rescale the nodes below the cap ``upper`` so that ``sum(p) = total_load``; True if K p is stale.
+
+        The capped nodes keep ``p = upper``; a node that the rescaling lifts above the cap is capped in
+        turn (a few rounds at most). While no node is capped this is the uniform rescaling, which
+        ``displacement`` (K p) follows exactly; otherwise p changes other than by a factor and K p must
+        be computed afresh.
+        """
+        mpi = self.problem.mpi
+        stale = False
+        for _ in range(8):
+            capped = p >= upper
+            n_capped, free_load = allsum(mpi, [np.count_nonzero(capped), p.sum(where=~capped)])
+            wanted = total_load - upper * n_capped
+            if wanted <= 0:
+                # The capped nodes alone carry more than the load: scale every node down, off the cap.
+                total, = allsum(mpi, [p.sum()])
+                p *= total_load / total
+                return True
+            if not free_load > 0:
+                # Every loaded node is capped and the load wants more: only a larger contact can carry
+                # it, which rescaling cannot make (the caller stops; see CappedPKLoad).
+                self.stopped_by = "the cap carries the whole load"
+                return True
+            scale = wanted / free_load
+            np.multiply(p, scale, out=p, where=~capped)
+            if n_capped or stale:
+                stale = True
+            else:
+                displacement *= scale
+            above, = allsum(mpi, [np.count_nonzero(p > upper)])
+            if not above:
+                break
+            np.minimum(p, upper, out=p)
+            stale = True
+        return bool(stale)

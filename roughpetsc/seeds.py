@@ -1,0 +1,44 @@
+"""The seed rule of every ensemble: one (master seed, index) means one surface in every mode.
+
+Realisation ``i`` of an ensemble with master seed ``S`` (``-ensemble_seed``) is the fractal surface
+(7.1)-(7.2) of the ``-surface_*`` options with the white-noise seed
+
+    seed_i = SeedSequence(S, spawn_key=(i,)).generate_state(1, uint32)[0] & 0x7fffffff,
+
+the first word of ``numpy.random.SeedSequence(S).spawn(i + 1)[i]`` cut to 31 bits (so that
+``-mode solve -surface_seed seed_i`` rebuilds that one surface). ``-mode stats -stats_ensemble n``
+and ``-mode ensemble -ensemble_size n`` both use it (docs/conventions.md, "Seeds"): the surfaces of a
+stats ensemble are those of the BEM ensemble with the same master seed, on any number of ranks.
+Children of a SeedSequence are statistically independent streams, unlike consecutive seeds.
+"""
+
+import numpy as np
+
+SEED_BITS = 0x7FFFFFFF
+RULE = ("seed_i = SeedSequence(ensemble_seed, spawn_key=(i,)).generate_state(1, uint32)[0] & 0x7fffffff; "
+        "surface = -surface_seed seed_i")
+MASTER_SEED_OPTION = ("ensemble_seed", 1, "master seed of an ensemble; surface i gets "
+                                          "SeedSequence(master).spawn(...)[i] (31-bit, see the file)")
+
+
+def surface_seed(master, index):
+    """The white-noise seed of realisation ``index`` of the ensemble with master seed ``master``.
+
+    Parameters
+    ----------
+    master : int
+        The master seed, >= 0.
+    index : int
+        The realisation, >= 0.
+
+    Returns
+    -------
+    int in [0, 2**31): the first word of ``SeedSequence(master).spawn(index + 1)[index]``, 31 bits.
+    """
+    sequence = np.random.SeedSequence(master, spawn_key=(index,))
+    return int(sequence.generate_state(1, np.uint32)[0] & SEED_BITS)
+
+
+def surface_seeds(master, count):
+    """The seeds of realisations ``0 .. count - 1`` in index order (:func:`surface_seed`)."""
+    return [surface_seed(master, index) for index in range(count)]

@@ -1,0 +1,364 @@
+"""``-mode solve``: one surface, a list of loads solved in order by one Solver, the files of the run.
+
+The option table :data:`OPTIONS` is what ``-help`` prints for the mode; its first part,
+:data:`SETTINGS_OPTIONS`, is read into the frozen :class:`SolveSettings` (with the general options
+of ``roughpetsc.cli``); the rest are read by the solvers themselves from the options database.
+This module imports PETSc only when it runs (``-help`` prints its table before PETSc starts).
+"""
+
+from dataclasses import dataclass, fields
+import os
+import signal
+import sys
+
+import numpy as np
+
+from .errors import UserError
+from .mode_settings import GENERAL_OPTIONS, check_fft, check_modulus, check_rtol, options_named, read_table
+
+# Read by read_settings into SolveSettings (besides the loads -pstar, -pbar, -gbar, -pstar_list).
+SETTINGS_OPTIONS = [
+    ("kkt_rtol", 1e-8, "stop when the natural KKT residual ||min(p/pbar, g/sqrt(m0h))||_inf <= this"),
+    ("json", "", "write a JSON summary (surface statistics, one entry per load step) to PATH"),
+    ("output", "", "write an HDF5 file to PATH: heights, the fields of -output_fields, each step's results and "
+                   "residual history, units and descriptions; a load path is saved as its steps finish"),
+    ("output_fields", "last", "pressure and gap fields in -output: last (of the last step) | all (also every "
+                              "step's, in steps/NNN/) | none"),
+    ("resume", False, "continue the load path saved in -output: its converged steps for the same problem and "
+                      "loads are kept, the rest solved from the last saved pressure"),
+    ("plot", "", "write a figure to PATH (.png, .pdf, .svg, ...): pressure and gap maps of the last step, A* "
+                 "against p* of a load path"),
+    ("progress_interval", 3.0, "on a terminal, print iteration, KKT residual and elapsed time of a running solve "
+                               "every this many seconds (0: never; never when stdout is not a terminal)"),
+    ("fft_threads", 1, "FFTW threads on one rank"),
+    ("fft_effort", "FFTW_MEASURE", "FFTW planner effort: FFTW_ESTIMATE | FFTW_MEASURE | FFTW_PATIENT "
+                                   "(measured plans are remembered, see -fft_wisdom)"),
+    ("fft_wisdom", "", "FFTW wisdom cache that makes measured plans, and so the iterates, repeat from run to run: "
+                       "PATH, none, or empty for ~/.cache/roughpetsc/fftw-wisdom-<cpu>.json"),
+    ("quiet", False, "print nothing but errors"),
+]
+
+# The physics beyond the periodic elastic half-space (read into SolveSettings).
+PHYSICS_OPTIONS = [
+    ("boundary", "periodic", "periodic (the cell repeats, Westergaard (3.33)) | free (an isolated body: Love's "
+                             "coefficients (3.31) by FFT on the zero-padded 2N x 2N grid)"),
+    ("hardness", 0.0, "hardness H, pressure units: perfect plasticity as the cap 0 <= p <= H (0: no cap); the "
+                      "plastic area fraction A_plastic is reported"),
+    ("stress_depths", "", "comma-separated depths (length units) at which the six subsurface stresses, the von "
+                          "Mises stress and its maximum are computed for the last step and written to -output "
+                          "(/stresses; nothing is computed without this option)"),
+    ("nu", 0.3, "Poisson's ratio of the body, for -stress_depths"),
+]
+
+LOAD_OPTIONS = [
+    ("pstar", 0.5, "load control: p* = pbar / sqrt(m0^p) (the default load)"),
+    ("pbar", "", "load control: mean pressure pbar, pressure units"),
+    ("gbar", "", "displacement control: prescribed mean gap (rigid separation) d, length units"),
+    ("pstar_list", "", "load control: comma-separated p* values solved in order with warm starts, or 'history' "
+                       "(the 95 steps of (7.11), D1 = 0.2/30)"),
+]
+
+# Read by the solvers from the options database (roughpetsc.solvers).
+SOLVER_OPTIONS = [
+    ("solve_max_time", 0.0, "stop a solve after this many seconds, reported as DIVERGED_USER (0: no limit)"),
+    ("pk_pc", "fourier", "Polonsky-Keer preconditioner: fourier (inverse symbol pi E*|k| on the contact set) | none"),
+    ("pk_active_set", "bccg", "Polonsky-Keer active set: bccg (overlapping nodes join the free set, Polak-Ribiere "
+                              "without restarts) | pk (as published: nodes enter after the step, CG restarts)"),
+    ("pk_refresh", 50, "Polonsky-Keer: recompute K p from scratch at least every this many iterations"),
+    ("bound_pc", "", "TAO bnls/bntr/bntl/tron/gpcg: fourier (inverse symbol on the free set; default of the BNK "
+                     "types) | none (default of tron, gpcg) | options (-tao_*pc_type decides)"),
+]
+
+OPTIONS = LOAD_OPTIONS + PHYSICS_OPTIONS + SETTINGS_OPTIONS + SOLVER_OPTIONS
+
+SOLVER_HELP = """Solvers (PETSc options):
+  (no -tao_type)          Polonsky-Keer projected CG (TAO type python) with the bound-constrained active set
+                          (-pk_active_set bccg), preconditioned by the inverse Westergaard symbol (-pk_pc fourier);
+                          load control (-pstar/-pbar) or displacement control (-gbar)
+  -tao_type <bound type>  blmvm bqnls bncg bqnkls bqnktr bnls bntr tron gpcg: displacement control directly,
+                          load control by a safeguarded root find on the mean gap around that type
+  -tao_type almm          load control by TAO ALMM (-tao_almm_subsolver_tao_type bqnls|blmvm|...)
+  -tao_monitor, -tao_view, -log_view and every other TAO/KSP/PC option work as usual."""
+
+
+@dataclass(frozen=True)
+class SolveSettings:
+    """What ``-mode solve`` was asked to do, checked; fields are named as the options are.
+
+    ``steps`` are the loads ``(kind, value)`` in solve order, ``kind`` one of ``pstar``, ``pbar``,
+    ``gbar``; ``load_option`` the option that gave them; ``tao_type`` None for Polonsky-Keer.
+    """
+
+    steps: tuple
+    load_option: str
+    E_star: float
+    overwrite: bool
+    kkt_rtol: float
+    json: str
+    output: str
+    output_fields: str
+    resume: bool
+    plot: str
+    progress_interval: float
+    fft_threads: int
+    fft_effort: str
+    fft_wisdom: str
+    quiet: bool
+    tao_type: object
+    surface_file: str
+    boundary: str = "periodic"
+    hardness: float = None
+    stress_depths: tuple = ()
+    nu: float = 0.3
+
+    @property
+    def control(self):
+        """``"displacement"`` for a prescribed mean gap, ``"load"`` otherwise."""
+        return "displacement" if self.steps[0][0] == "gbar" else "load"
+
+    @property
+    def gather_fields(self):
+        """Whether each step's pressure and gap are gathered on rank 0 (a plot or fields in -output)."""
+        return bool(self.plot) or bool(self.stress_depths) or (bool(self.output) and self.output_fields != "none")
+
+
+def load_steps(reader):
+    """The list of loads: ``("pstar" | "pbar" | "gbar", value)`` in the order to solve."""
+    given = [name for name in ("pstar", "pbar", "gbar", "pstar_list") if reader.has(name)]
+    if len(given) > 1:
+        raise UserError("give only one of -pstar, -pbar, -gbar, -pstar_list; got " + ", ".join("-" + g for g in given))
+    if given == ["pstar_list"]:
+        if reader.string("pstar_list", "").strip().lower() == "history":
+            from . import loads
+
+            return [("pstar", float(v)) for v in loads.history()], "pstar_list"
+        values = reader.reals("pstar_list")
+        return [("pstar", v) for v in values], "pstar_list"
+    name = given[0] if given else "pstar"
+    value = reader.real(name, 0.5)
+    return [(name, value)], name
+
+
+def read_settings(reader, general_options=GENERAL_OPTIONS):
+    """The :class:`SolveSettings` of the options database; ``general_options`` is the table of ``-E_star``, ...
+
+    Raises :class:`UserError` naming the option for a bad value.
+    """
+    from .results import OUTPUT_FIELDS
+
+    steps, load_option = load_steps(reader)
+    for _, value in steps:
+        if not (value > 0 and np.isfinite(value)):
+            raise UserError(f"-{load_option} must be positive and finite, got {value}")
+    names = {field.name for field in fields(SolveSettings)}
+    values = {name: value for name, value in read_table(reader, general_options + SETTINGS_OPTIONS).items()
+              if name in names}
+    settings = SolveSettings(steps=tuple(steps), load_option=load_option, tao_type=reader.string("tao_type", "") or None,
+                             surface_file=reader.string("surface_file", ""), **values, **read_physics(reader))
+    check_rtol(settings.kkt_rtol)
+    check_modulus(settings.E_star)
+    if settings.output_fields not in OUTPUT_FIELDS:
+        raise UserError(f"-output_fields: unknown value '{settings.output_fields}' (one of {', '.join(OUTPUT_FIELDS)})")
+    if settings.resume and not settings.output:
+        raise UserError("-resume needs -output: the file of the run to continue")
+    check_fft(settings.fft_threads, settings.fft_effort)
+    return settings
+
+
+def read_physics(reader):
+    """The values of :data:`PHYSICS_OPTIONS`, checked: ``boundary``, ``hardness`` (None: no cap), ``stress_depths``, ``nu``."""
+    from .contact import BOUNDARIES
+    from .stresses import check_depths, check_poisson
+
+    values = read_table(reader, PHYSICS_OPTIONS)
+    if values["boundary"] not in BOUNDARIES:
+        raise UserError(f"-boundary: unknown boundary '{values['boundary']}' (one of {', '.join(BOUNDARIES)})")
+    hardness = values["hardness"]
+    if not (hardness >= 0 and np.isfinite(hardness)):
+        raise UserError(f"-hardness must be a positive pressure (0: no cap), got {hardness}")
+    depths = tuple(reader.reals("stress_depths")) if reader.has("stress_depths") else ()
+    with options_named():
+        if depths:
+            check_depths(depths)
+        check_poisson(values["nu"])
+    return {"boundary": values["boundary"], "hardness": hardness or None, "stress_depths": depths,
+            "nu": values["nu"]}
+
+
+def check_files(settings, comm):
+    """Refuse, on every rank, outputs that exist (without -overwrite), overwrite the input or cannot be written."""
+    from . import io
+
+    # Checked on rank 0, refused on every rank; the file of -output is meant to exist with -resume.
+    outputs = [("json", settings.json), ("output", settings.output), ("plot", settings.plot)]
+    io.on_root(comm, io.check_outputs, outputs, settings.overwrite, [("surface_file", settings.surface_file)],
+               ("output",) if settings.resume else ())
+    if settings.plot:
+        io.check_figure_format(settings.plot, "plot")
+
+
+def printer(quiet, comm):
+    """``say(text)``: print on rank 0 unless ``quiet``."""
+    def say(text):
+        if not quiet and comm.Get_rank() == 0:
+            print(text, flush=True)
+    return say
+
+
+def run(reader, comm):
+    """Solve the loads of the options on the surface of the options; the exit status (0, 3 or 130)."""
+    from petsc4py import PETSc
+
+    from . import fftw, io, surfaces
+    from .contact import ContactProblem
+    from .solvers import Solver
+    from .kkt import Progress
+    from .options import check_unused
+    from .results import PathRecord
+    from .slab import row_split
+    from .surface_moments import surface_moments
+
+    settings = read_settings(reader)
+    say = printer(settings.quiet, comm)
+    check_files(settings, comm)
+    effort = fftw.planner_effort(settings.fft_effort)
+    wisdom = fftw.wisdom_path(settings.fft_wisdom)
+    if not settings.surface_file:
+        # Before the surface is built: a grid with fewer rows than ranks is refused by name.
+        row_split(surfaces.grid_from_options(reader).n0, comm.Get_size())
+    grid, heights = surfaces.from_options(reader)
+    with fftw.remembered_plans(comm, wisdom, effort), options_named():
+        problem = ContactProblem(grid, heights, settings.E_star, PETSc.COMM_WORLD, settings.fft_threads, effort,
+                                 boundary=settings.boundary, hardness=settings.hardness)
+    statistics = surface_moments(grid, heights, settings.E_star)
+    solver = Solver(problem, settings.control, settings.tao_type, settings.kkt_rtol)
+    rank0 = comm.Get_rank() == 0
+    if settings.progress_interval > 0 and rank0 and not settings.quiet and sys.stdout.isatty():
+        problem.progress = Progress(settings.progress_interval, sys.stdout)
+    # A batch system's time limit (SIGTERM) ends the run like Ctrl-C: the finished steps are kept.
+    previous_sigterm = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    try:
+        check_unused(final=False)  # misspellings fail now; options PETSc reads after a solve are checked then
+        summary = {"grid": [grid.n0, grid.n1], "length": [grid.l0, grid.l1], "E_star": settings.E_star,
+                   "surface": statistics, "surface_parameters": dict(surfaces.parameters(reader), surface_L=grid.l1),
+                   "sqrt_m0h": problem.sqrt_m0h, "sqrt_m0p": problem.sqrt_m0p,
+                   "solver": solver.name, "control": settings.control, "kkt_rtol": settings.kkt_rtol,
+                   "boundary": settings.boundary, "hardness": settings.hardness or 0.0,
+                   "ranks": comm.Get_size(), **io.provenance()}
+        record = PathRecord(summary, heights, settings.output_fields)
+        h5_path = settings.output
+        if settings.resume and os.path.exists(h5_path):
+            start = record.resume_from(h5_path, list(settings.steps))
+            if start is not None:  # the next solve scales it to its load (Solver's warm start)
+                problem.local(solver.pressure)[...] = start[problem.local_rows] / problem.pressure_scale
+        cap = f", hardness {settings.hardness:g}" if settings.hardness else ""
+        say(f"roughpetsc: {grid.n0}x{grid.n1} grid ({settings.boundary}{cap}) on {comm.Get_size()} rank(s), "
+            f"solver {solver.name}, E*={settings.E_star:g}, sqrt(m0h)={problem.sqrt_m0h:.4g}, "
+            f"sqrt(m0p)={problem.sqrt_m0p:.4g}, alpha_h={statistics['alpha_h']:.4g}, "
+            f"alpha_p={statistics['alpha_p']:.4g}")
+        say(f"{'p*':>10} {'A*':>10} {'A*corr':>10} {'g*':>11} {'KKT nat':>9} {'its':>6} {'Kapps':>6} "
+            f"{'time s':>8}  reason")
+        for step in record.steps:
+            say(step_line(step) + f"  (from {h5_path})")
+        try:
+            solve_path(settings, solver, record, comm, say)
+        except KeyboardInterrupt:
+            if rank0 and record.steps:
+                record.write(h5_path, settings.json)
+            if rank0:
+                kept = f"; {h5_path} keeps them (rerun with -resume to continue)" if h5_path and record.steps else ""
+                print(f"roughpetsc: interrupted after {len(record.steps)} of {len(settings.steps)} step(s){kept}",
+                      file=sys.stderr, flush=True)
+            return 130
+        if settings.stress_depths:
+            io.on_root(comm, record_stresses, settings, record, grid)
+        io.on_root(comm, write_outputs, settings, record, grid)
+        return 0 if all(step["converged"] for step in record.steps) else 3
+    finally:
+        signal.signal(signal.SIGTERM, previous_sigterm)
+        solver.destroy()
+        problem.destroy()
+
+
+def record_stresses(settings, record, grid):
+    """The subsurface stresses of the last step at ``settings.stress_depths`` into ``record`` (rank 0)."""
+    from .stresses import free_stresses, periodic_stresses
+
+    pressure = record.last_fields.get("pressure")
+    if pressure is None:
+        raise UserError("-stress_depths: the last step's pressure field is not available (all steps taken from a "
+                        "file without fields)")
+    if settings.boundary == "periodic":
+        depths = periodic_stresses(pressure, (grid.l0, grid.l1), settings.stress_depths, settings.nu)
+    else:
+        depths = free_stresses(pressure, (grid.l0 / grid.n0, grid.l1 / grid.n1), settings.stress_depths,
+                               settings.nu)
+    record.stresses = list(depths)
+    for depth in record.stresses:
+        print(f"  stresses at depth {depth.depth:.4g}: max von Mises {depth.max_von_mises:.4g} at node "
+              f"{depth.max_location}", flush=True)
+
+
+def write_outputs(settings, record, grid):
+    """The JSON, HDF5 and figure of the run (rank 0; a failure there is every rank's error, io.on_root)."""
+    from . import plots
+
+    record.write(settings.output, settings.json)
+    if settings.plot and not record.last_fields:  # every step taken from a file without fields
+        print(f"roughpetsc: -plot: no fields to plot in {settings.output} (-output_fields none)", file=sys.stderr)
+    elif settings.plot:
+        plots.plot_solution(settings.plot, grid, record.last_fields["pressure"], record.last_fields["gap"],
+                            record.steps)
+
+
+def step_line(step):
+    """The table row of a step summary."""
+    flag = "" if step["converged"] else "  NOT CONVERGED"
+    plastic = f"  A_plastic {step['A_plastic']:.5g}" if step.get("A_plastic") else ""
+    return (f"{step['pstar']:10.5g} {step['A']:10.5g} {step['A_corrected']:10.5g} {step['gstar']:11.5g} "
+            f"{step['kkt']['natural']:9.2e} {step['iterations']:6d} {step['operator_applications']:6d} "
+            f"{step['time_s']:8.3f}  {step['reason']}{flag}{plastic}")
+
+
+def solve_path(settings, solver, record, comm, say):
+    """Solve the loads of ``settings.steps`` not yet in ``record``, recording each and checkpointing -output.
+
+    Each step's pressure and gap are gathered on rank 0 for the record when
+    ``settings.gather_fields``. Every option must have been used once the
+    first solve is done (PETSc reads viewers and converged reasons during and
+    after TAOSolve); the check runs then, before any file is written.
+    """
+    from petsc4py import PETSc
+
+    from . import io
+    from .options import check_unused
+    from .slab import gather_rows
+
+    checked = False
+    steps = settings.steps
+    for index, (kind, value) in enumerate(steps):
+        if index < len(record.steps):
+            continue
+        stage = PETSc.Log.Stage(f"RP step {index:03d} {kind}={value:g}")  # -log_view: one stage per load
+        stage.push()
+        try:
+            result = solver.solve(**{kind: value})
+        finally:
+            stage.pop()
+        solver_ran = not result.reason.startswith("COMPLETE_CONTACT")  # the exact answer runs no TAO
+        if not checked:
+            # Once a TAO solve has run, every option must have been read; before, only those that are
+            # not read during or after a solve (a path wholly beyond complete contact runs none).
+            check_unused(final=solver_ran)
+            checked = solver_ran
+        say(step_line(result.summary()))
+        gathered = [gather_rows(comm, field) for field in solver.fields()] if settings.gather_fields else [None, None]
+        record.add(dict(result.summary(), load_option=kind, load_value=value), result.history, *gathered)
+        if settings.output and index < len(steps) - 1:  # every rank takes part: a failed write stops them all
+            io.on_root(comm, checkpoint, record, settings.output)
+
+
+def checkpoint(record, h5_path):
+    """Rewrite ``h5_path`` with the steps so far when it is time to (rank 0)."""
+    if record.due():
+        record.write(h5_path)

@@ -1,0 +1,91 @@
+"""The one HDF5 store of roughpetsc: one atomic writer, and one schema and one reader per file kind.
+
+File kinds (each module holds its layout, its writer and its reader):
+
+* :mod:`roughpetsc.store.load_path`: ``-mode solve -output``, a load path as its steps finish;
+* :mod:`roughpetsc.store.stats_file`: ``-mode stats -stats_h5``, surface statistics of one surface or an ensemble;
+* :mod:`roughpetsc.store.ensemble_file`: ``-mode ensemble -output``, BEM solves of many surfaces, resumable.
+
+Every file records the options and versions that made it (:func:`roughpetsc.io.provenance`).
+
+Writing (:func:`write`): the whole file is built in memory by h5py, then written as bytes to a
+hidden temporary in the target's folder, fsync'ed and renamed over the target
+(:class:`roughpetsc.io.atomic_path` with ``durable=True``). A kill at any moment leaves the previous
+or the new complete file, and a full disk is one plain ``OSError`` of the byte write (HDF5 writing to a
+full disk itself leaves half-closed objects whose clean-up prints tracebacks of its own); the faults
+study (``studies/faults.py``) checks both.
+
+Parallel HDF5: the files are written by world rank 0 after the data are gathered to it. Writing
+collectively (``h5py.File(..., driver="mpio", comm=...)``) needs an h5py built against a parallel
+HDF5, which this installation does not have (``h5py.get_config().mpi`` is False); with one, only the
+field datasets of a load path would gain from it, the rest of each file is small.
+"""
+
+from io import BytesIO
+import json
+
+import numpy as np
+
+from ..io import atomic_path, jsonable
+
+
+def write(path, build):
+    """Write an HDF5 file atomically and durably: ``build(h5file)`` fills it in memory first.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file to create or replace.
+    build : callable
+        Called with an open, empty, writable ``h5py.File``; whatever it writes is the file.
+
+    Raises :class:`roughpetsc.errors.UserError` naming ``path`` if the file cannot be written.
+    """
+    import h5py
+
+    image = BytesIO()
+    with h5py.File(image, "w") as f:
+        build(f)
+    with atomic_path(path, durable=True) as temporary, open(temporary, "wb") as handle:
+        handle.write(image.getbuffer())
+
+
+def attribute(value):
+    """A value as an HDF5 attribute: dicts and lists as JSON text, None as the empty string."""
+    if isinstance(value, (dict, list)):
+        return json.dumps(jsonable(value))
+    return "" if value is None else value
+
+
+def from_attribute(value, json_keys=(), key=None):
+    """Inverse of :func:`attribute` for one attribute ``key``: numpy scalars as Python, "" as None."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if key in json_keys:
+        return json.loads(value)
+    return None if isinstance(value, str) and value == "" else value
+
+
+def set_attributes(node, mapping):
+    """Every ``{name: value}`` of ``mapping`` as an attribute of ``node`` (:func:`attribute` form)."""
+    for key, value in mapping.items():
+        node.attrs[key] = attribute(value)
+
+
+def read(path):
+    """Any roughpetsc HDF5 file as a flat dict ``{"group/name": value, "@attr": value, "name@attr": value}``."""
+    import h5py
+
+    out = {}
+    with h5py.File(path, "r") as f:
+        for key, value in f.attrs.items():
+            out["@" + key] = value
+
+        def visit(name, item):
+            if isinstance(item, h5py.Dataset):
+                out[name] = item[()]
+            for key, value in item.attrs.items():
+                out[f"{name}@{key}"] = value
+
+        f.visititems(visit)
+    return out

@@ -1,0 +1,215 @@
+"""The dissertation's Figs. 3.7-3.10 and 7.11-7.21 and Table 7.7 from our BEM ensembles (ensemble_figures.py runs them).
+
+BEM means, standard deviations, kappa = dA*/dp* and the model curves at the load steps are those the
+ensemble files store (:class:`ensemble_common.Ens`).
+"""
+
+import numpy as np
+
+from ensemble_common import (DISSERTATION_FIG_3_9_A, DISSERTATION_TABLE_7_7, EARLY_PMAX, FIELD_GROUP, FIELD_N,
+                             GROUPS_7, LABEL, STYLE, M, bem, early_curve, panel_figures, plt, preferred, read_fields,
+                             save, title)
+
+
+def fig_3_8_to_3_10(ensembles, produced, report):
+    e = ensembles.get((FIELD_GROUP, FIELD_N)) or preferred(ensembles, FIELD_GROUP)
+    if e is None:
+        return
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    for k in range(e.n):
+        ax[0].plot(e.p, e.A_all[k], color="0.75", lw=0.6)
+        ax[1].semilogy(e.p, e.g_all[k], color="0.75", lw=0.6)
+    ax[0].plot(e.p, e.A, "k-", lw=1.6, label=f"mean of {e.n} surfaces")
+    ax[1].semilogy(e.p, e.g, "k-", lw=1.6, label=f"mean of {e.n} surfaces")
+    ax[0].set(xlabel="p* = pbar / sqrt(m0^p)", ylabel="A*", title="Fig. 3.8(a): contact ratio (grey: each surface)")
+    ax[1].set(xlabel="p* = pbar / sqrt(m0^p)", ylabel="g* = gbar / sqrt(m0^h)", title="Fig. 3.8(b): mean gap")
+    for a in ax:
+        a.legend()
+        a.grid(alpha=0.3)
+    fig.suptitle(f"BEM, group #{e.group}, {e.N}^2")
+    save(fig, "fig3_8_area_gap.png", produced)
+
+    fields = read_fields()
+    if fields is None:
+        report += ["Figs. 3.9/3.10: not drawn (run `ensemble_figures.py --extras` first).", ""]
+        return
+    at = fields["attrs"]
+    n = fields["heights"].shape[0]
+    for name, fig_no, what in (("contact", "3.9", "contact area (black: p > 0)"),
+                               ("gap", "3.10", "gap g / sqrt(m0^h)")):
+        fig, axes = plt.subplots(1, 4, figsize=(17, 4.6))
+        for k, (ax, step) in enumerate(zip(axes, fields["steps"])):
+            if name == "contact":
+                ax.imshow(step["contact"], cmap="gray_r", origin="lower", extent=(0, 1, 0, 1),
+                          interpolation="nearest")
+            else:
+                im = ax.imshow(step["gap"], cmap="viridis", origin="lower", extent=(0, 1, 0, 1),
+                               interpolation="nearest")
+                fig.colorbar(im, ax=ax, shrink=0.75)
+            sa = step["attrs"]
+            ax.set_title(f"({'abcd'[k]}) A* = {100 * sa['A']:.2f}% (dissertation "
+                         f"{100 * DISSERTATION_FIG_3_9_A[k]:.2f}%)\n"
+                         f"p* = {sa['pstar']:.4f}", fontsize=9)
+            ax.set_xticks([])
+            ax.set_yticks([])
+        fig.suptitle(f"Fig. {fig_no}: {what}; group #{at['group']} surface {at['index']} (seed {at['seed']}), "
+                     f"{n}^2 nodes")
+        save(fig, f"fig{fig_no.replace('.', '_')}_{name}.png", produced)
+    fig, ax = plt.subplots(figsize=(5.5, 4.6))
+    im = ax.imshow(fields["heights"] / at["sqrt_m0h"], cmap="terrain", origin="lower", extent=(0, 1, 0, 1))
+    fig.colorbar(im, ax=ax)
+    ax.set_title(f"Fig. 3.7: h / sqrt(m0^h), group #{at['group']} surface {at['index']}")
+    save(fig, "fig3_7_heights.png", produced)
+    report += ["### Figs. 3.9/3.10 (contact area and gap pictures)", "",
+               f"Surface {at['index']} of group #{at['group']} (seed {at['seed']}), {n}^2 nodes; p* chosen by "
+               "interpolating that surface's ensemble A*(p*) at the dissertation's four contact ratios:", "",
+               "| panel | dissertation A* | our A* | p* | g* | KKT natural | converged "
+               "|", "|---|---|---|---|---|---|---|"]
+    for k, step in enumerate(fields["steps"]):
+        sa = step["attrs"]
+        report.append(f"| ({'abcd'[k]}) | {100 * DISSERTATION_FIG_3_9_A[k]:.2f}% | {100 * sa['A']:.2f}% | "
+                      f"{sa['pstar']:.4f} | "
+                      f"{sa['gstar']:.4f} | {sa['kkt']:.1e} | {bool(sa['converged'])} |")
+    report.append("")
+
+
+def fig_7_full(ensembles, produced):
+    """Figs. 7.11 (A*), 7.12 (g*), 7.13 (g* and rms gap in contact) over the whole history.
+
+    Model curves are the file's, at its load steps: early-contact models up to p* = 0.2 (where the
+    store defines them), nearly-complete ones and Persson's everywhere.
+    """
+    table = (("7.11", (1, 2)), ("7.12", (1, 2)), ("7.13", (1, 2)))
+    for fig_no, _, ax, e in panel_figures(table, ensembles, produced):
+        every = np.ones(e.p.size, bool)
+        if fig_no == "7.11":
+            bem(ax, e, e.A, e.A_std, every=2)
+            for name, label in (("greenwood", "Greenwood (early)"), ("bgt_asymptotic", "asymptotic BGT (4.35)")):
+                p, A = early_curve(e, name, "A", every)
+                ax.plot(p, A, STYLE[name], label=label)
+            A = e.model("complete", "greenwood", "A")
+            if A is not None:
+                ax.plot(e.p, np.clip(A, 0, None), "-", label="Greenwood (nearly complete)")
+            A = e.model("persson", None, "A")
+            if A is not None:
+                ax.plot(e.p, A, "-", color="tab:brown", label="Persson (5.59)")
+            ax.set(ylabel="A*", ylim=(0, 1.05))
+        elif fig_no == "7.12":
+            bem(ax, e, e.g, e.g_std, every=2)
+            for name in ("greenwood", "bgt_asymptotic"):
+                p, d = early_curve(e, name, "dstar", every)
+                ok = d > 1e-3
+                ax.semilogy(p[ok], d[ok], STYLE[name], label=f"{LABEL[name]} (early, g* ~ d*)")
+            g = e.model("complete", "greenwood", "gstar")
+            if g is not None:
+                ok = g > 0
+                ax.semilogy(e.p[ok], g[ok], "-", label="Greenwood (nearly complete)")
+            g = e.model("persson", None, "gstar")
+            if g is not None:
+                ax.semilogy(e.p, g, "-", color="tab:brown", label="Persson (App. E)")
+            ax.set(ylabel="g* = gbar / sqrt(m0^h)", ylim=(1e-4, 5))
+        else:
+            ax.semilogy(e.p, e.g, "ko-", ms=3, label="mean gap g*")
+            ax.semilogy(e.p, e.rms, "s-", ms=3, color="tab:red",
+                        label="rms gap in contact / sqrt(m0^h) (3.50)")
+            ax.set(ylabel="g*, rms gap in contact (/ sqrt(m0^h))")
+        ax.set(xlabel="p*", title=title(e, fig_no))
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+
+
+def fig_7_early(ensembles, produced):
+    """Figs. 7.14/7.15 (A*), 7.16 (kappa = dA*/dp*), 7.17 (g*) at early contact p* <= 0.2."""
+    table = (("7.14", (1, 2), "A"), ("7.15", (3, 4), "A"), ("7.16", (1, 2), "kappa"), ("7.17", (1, 2), "g"))
+    for fig_no, kind, ax, e in panel_figures(table, ensembles, produced):
+        sel = e.p <= EARLY_PMAX + 1e-12
+        kappa = e.models["kappa"]
+        if kind == "A":
+            bem(ax, e, e.A, e.A_std, sel)
+            ax.plot(e.p[sel], e.Ac[sel], "x", color="tab:gray", ms=4, label="BEM mean, perimeter-corrected")
+        elif kind == "g":
+            bem(ax, e, e.g, e.g_std, sel)
+        else:
+            ax.plot(e.p[sel], kappa["bem_A"][sel], "ko", ms=3, label=f"BEM (mean of {e.n}, finite differences)")
+            ax.plot(e.p[sel], kappa["bem_A_corrected"][sel], "x", color="tab:gray", ms=4,
+                    label="BEM, perimeter-corrected")
+        for name in M.EARLY_MODELS:
+            if kind == "kappa":
+                if "early_" + name in kappa:
+                    ok = sel & np.isfinite(kappa["early_" + name])
+                    ax.plot(e.p[ok], kappa["early_" + name][ok], STYLE[name], label=LABEL[name])
+                continue
+            p, y = early_curve(e, name, "A" if kind == "A" else "dstar", sel)
+            ax.plot(p, y, STYLE[name], label=LABEL[name] if kind == "A" else f"{LABEL[name]} (d*)")
+        y = e.model("persson", None, "A" if kind == "A" else "gstar") if kind != "kappa" else kappa.get("persson")
+        if y is not None:
+            ax.plot(e.p[sel], y[sel], "-", color="tab:brown", label="Persson")
+        if kind == "A":
+            ax.set(ylabel="A*")
+        elif kind == "g":
+            ax.set(ylabel="g* (models: d*)")
+        else:
+            ax.axhline(np.sqrt(np.pi / 2), color="0.6", lw=0.8, ls=":")
+            ax.set(ylabel="kappa = dA*/dp*")
+        ax.set(xlabel="p*", xlim=(0, EARLY_PMAX), title=title(e, fig_no))
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="lower left" if kind == "kappa" else "best")
+
+
+def fig_7_complete(ensembles, produced):
+    """Figs. 7.18/7.19 (1 - A*) and 7.20/7.21 (g*) at nearly complete contact p* in [2, 4]."""
+    table = (("7.18", (1, 2), "A"), ("7.19", (3, 4), "A"), ("7.20", (1, 2), "g"), ("7.21", (3, 4), "g"))
+    for fig_no, kind, ax, e in panel_figures(table, ensembles, produced):
+        sel = e.p >= 2.0 - 1e-12
+        if kind == "A":
+            bem(ax, e, 1 - e.A, e.A_std, sel)
+            ax.plot(e.p[sel], 1 - e.Ac[sel], "x", color="tab:gray", ms=4, label="BEM, perimeter-corrected")
+        else:
+            bem(ax, e, e.g, e.g_std, sel)
+        for name, label, style, color in [(name, LABEL[name], STYLE[name], None) for name in M.COMPLETE_MODELS] \
+                + [(None, "Persson", "-", "tab:brown")]:
+            family = "complete" if name else "persson"
+            y = e.model(family, name, "A" if kind == "A" else "gstar")
+            if y is not None:
+                ax.plot(e.p[sel], (1 - y if kind == "A" else y)[sel], style, color=color, label=label)
+        ax.set_yscale("log")
+        ax.set(xlabel="p*", ylabel="1 - A*" if kind == "A" else "g*", xlim=(2, 4), title=title(e, fig_no))
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+
+
+def table_7_7(ensembles, report):
+    report += ["## Table 7.7: bandwidth parameters (mean ± std over the surfaces)", "",
+               "Ours from the spectral moments of each surface (what `-mode ensemble` stores and what the models "
+               "above use) and from the dissertation's finite differences (7.6)/(7.7) (the dissertation's \"Num\"); "
+               "closed forms "
+               "(2.25)/(2.59) of the continuous PSD.", "",
+               "The dissertation prints the same std (0.2144) for alpha^h and alpha^p of group 1, probably a copy "
+               "slip. Our "
+               "spectral values agree with the closed forms; the FD values depend on the grid (at 512^2 there are only "
+               "8 and 4 nodes per 1/k_s for groups 1 and 2, the dissertation had 16 and 8), so they exceed the "
+               "dissertation's.", "",
+               "| group | grid, surfaces | alpha^h ours (spectral) | alpha^h ours (FD) | alpha^h closed form | "
+               "alpha^h dissertation | alpha^p ours (spectral) | alpha^p ours (FD) | alpha^p closed form | alpha^p "
+               "dissertation |",
+               "|---|---|---|---|---|---|---|---|---|---|"]
+    from roughpetsc import spectra
+
+    for group in sorted(GROUPS_7):
+        for (g, n), e in sorted(ensembles.items()):
+            if g != group:
+                continue
+            kl, ks, H = GROUPS_7[group]
+            ch, cp = spectra.fractal_height_bandwidth(kl, ks, H), spectra.fractal_pressure_bandwidth(kl, ks, H)
+            fd_h = fd_p = "— (file of format 1: rerun the ensemble to store them)"
+            if e.fd is not None:
+                fd_h, fd_p = (f"{e.fd[key][0]:.4f} ± {e.fd[key][1]:.4f}" for key in ("h", "p"))
+            diss_h = diss_p = "—"
+            if group in DISSERTATION_TABLE_7_7:
+                (sh, ssh), (sp, ssp) = DISSERTATION_TABLE_7_7[group]
+                diss_h, diss_p = f"{sh:.4f} ± {ssh:.4f}", f"{sp:.4f} ± {ssp:.4f}"
+            report.append(f"| {group} | {n}^2, {e.n} | {e.alpha_h:.4f} ± {e.alpha_h_std:.4f} | {fd_h} | {ch:.4f} | "
+                          f"{diss_h} | {e.alpha_p:.4f} ± {e.alpha_p_std:.4f} | {fd_p} | {cp:.4f} | {diss_p} |")
+    report.append("")
+
+
