@@ -33,9 +33,14 @@ class PathRecord:
         The whole surface, length units.
     keep : one of OUTPUT_FIELDS
         ``-output_fields``: pressure and gap of every step, of the last step, or none.
+    first_row, local_rows : int or None
+        None: the fields given to :meth:`add` are whole (rank 0). Else they are this rank's
+        ``local_rows`` rows from ``first_row`` on, and every rank writes its rows of the file
+        (:meth:`write` with ``comm``).
     """
 
-    def __init__(self, summary, heights, keep):
+    def __init__(self, summary, heights, keep, first_row=None, local_rows=None):
+        self.first_row, self.local_rows = first_row, local_rows
         self.summary = summary
         self.heights = heights
         self.keep = keep
@@ -60,13 +65,23 @@ class PathRecord:
     def as_summary(self):
         return dict(self.summary, steps=self.steps)
 
-    def write(self, h5_path, json_path=None):
-        """Write the files of the steps so far (rank 0), each atomically."""
+    def write(self, h5_path, json_path=None, comm=None, with_fields=True):
+        """Write the files of the steps so far, each atomically.
+
+        On rank 0 alone, or, for a record of distributed fields (``first_row``), on every rank of
+        ``comm`` (the JSON by rank 0). ``with_fields=False`` leaves the pressure and gap fields out
+        (rank 0 alone after an interruption, when the other ranks may not take part).
+        """
         start = time.perf_counter()
+        distributed = self.first_row is not None and with_fields
+        rank0 = comm is None or comm.Get_rank() == 0
         if h5_path:
-            fields = dict(heights=self.heights, **(self.last_fields if self.keep != "none" else {}))
-            load_path.write(h5_path, self.as_summary(), fields, self.histories, self.step_fields, self.stresses)
-        if json_path:
+            kept = self.last_fields if self.keep != "none" and with_fields else {}
+            step_fields = self.step_fields if with_fields else {}
+            load_path.write(h5_path, self.as_summary(), dict(heights=self.heights, **kept), self.histories,
+                            step_fields, self.stresses, comm=comm if distributed else None,
+                            first_row=self.first_row if distributed else None)
+        if json_path and rank0:
             io.write_json(json_path, self.as_summary())
         self.written_at = time.perf_counter()
         self.write_seconds = self.written_at - start
@@ -105,16 +120,18 @@ class PathRecord:
             raise UserError(f"-resume: {path} was made for another problem (different {', '.join(differ)}); "
                             "give another -output, or the options that made it")
         start = stored["last_fields"].get("pressure")
+        rows = slice(None) if self.first_row is None else slice(self.first_row, self.first_row + self.local_rows)
         for (option, value), step in zip(loads, stored["steps"]):
             summary = step["summary"]
             if not (summary.get("converged") and summary.get("load_option") == option
                     and summary.get("load_value") == value):
                 break
-            self.add(summary, step["history"], step["fields"].get("pressure"), step["fields"].get("gap"))
+            fields = [step["fields"][name][rows] if name in step["fields"] else None for name in ("pressure", "gap")]
+            self.add(summary, step["history"], *fields)
             if "pressure" in step["fields"]:
                 start = step["fields"]["pressure"]
         if self.keep != "none" and self.steps and len(self.steps) == len(stored["steps"]) \
                 and "pressure" in stored["last_fields"]:
             # Every step taken: the last fields of the file are those of the last step taken.
-            self.last_fields = dict(stored["last_fields"])
+            self.last_fields = {name: array[rows] for name, array in stored["last_fields"].items()}
         return start

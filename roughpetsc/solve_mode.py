@@ -209,7 +209,7 @@ def run(reader, comm):
     """Solve the loads of the options on the surface of the options; the exit status (0, 3 or 130)."""
     from petsc4py import PETSc
 
-    from . import fftw, io, surfaces
+    from . import fftw, io, store, surfaces
     from .contact import ContactProblem
     from .solvers import Solver
     from .kkt import Progress
@@ -245,7 +245,11 @@ def run(reader, comm):
                    "solver": solver.name, "control": settings.control, "kkt_rtol": settings.kkt_rtol,
                    "boundary": settings.boundary, "hardness": settings.hardness or 0.0,
                    "ranks": comm.Get_size(), **io.provenance()}
-        record = PathRecord(summary, heights, settings.output_fields)
+        # Fields written by every rank into its rows where h5py is the parallel build (store.write_distributed).
+        distributed = bool(settings.output) and settings.output_fields != "none" and store.parallel_hdf5(comm)
+        rows = problem.local_rows
+        record = PathRecord(summary, heights, settings.output_fields,
+                            *((rows.start, rows.stop - rows.start) if distributed else ()))
         h5_path = settings.output
         if settings.resume and os.path.exists(h5_path):
             start = record.resume_from(h5_path, list(settings.steps))
@@ -264,15 +268,19 @@ def run(reader, comm):
             solve_path(settings, solver, record, comm, say)
         except KeyboardInterrupt:
             if rank0 and record.steps:
-                record.write(h5_path, settings.json)
+                # Rank 0 alone (the others may be anywhere): distributed fields cannot be written now.
+                record.write(h5_path, settings.json, with_fields=not distributed)
             if rank0:
                 kept = f"; {h5_path} keeps them (rerun with -resume to continue)" if h5_path and record.steps else ""
                 print(f"roughpetsc: interrupted after {len(record.steps)} of {len(settings.steps)} step(s){kept}",
                       file=sys.stderr, flush=True)
             return 130
+        whole = whole_last_fields(record, comm, distributed, settings)
         if settings.stress_depths:
-            io.on_root(comm, record_stresses, settings, record, grid)
-        io.on_root(comm, write_outputs, settings, record, grid)
+            io.on_root(comm, record_stresses, settings, record, grid, whole)
+        if distributed:
+            record.write(settings.output, comm=comm)
+        io.on_root(comm, write_outputs, settings, record, grid, whole, not distributed)
         return 0 if all(step["converged"] for step in record.steps) else 3
     finally:
         signal.signal(signal.SIGTERM, previous_sigterm)
@@ -280,11 +288,22 @@ def run(reader, comm):
         problem.destroy()
 
 
-def record_stresses(settings, record, grid):
+def whole_last_fields(record, comm, distributed, settings):
+    """The last step's whole pressure and gap on rank 0 (collective), for the figure and the stresses."""
+    from .slab import gather_rows
+
+    if not distributed:
+        return record.last_fields
+    if not (settings.plot or settings.stress_depths) or not record.last_fields:
+        return {}
+    return {name: gather_rows(comm, array) for name, array in record.last_fields.items()}
+
+
+def record_stresses(settings, record, grid, fields):
     """The subsurface stresses of the last step at ``settings.stress_depths`` into ``record`` (rank 0)."""
     from .stresses import free_stresses, periodic_stresses
 
-    pressure = record.last_fields.get("pressure")
+    pressure = fields.get("pressure")
     if pressure is None:
         raise UserError("-stress_depths: the last step's pressure field is not available (all steps taken from a "
                         "file without fields)")
@@ -299,16 +318,16 @@ def record_stresses(settings, record, grid):
               f"{depth.max_location}", flush=True)
 
 
-def write_outputs(settings, record, grid):
-    """The JSON, HDF5 and figure of the run (rank 0; a failure there is every rank's error, io.on_root)."""
+def write_outputs(settings, record, grid, fields, with_h5=True):
+    """The JSON, HDF5 (unless written by every rank) and figure of the run (rank 0; a failure there is every
+    rank's error, io.on_root). ``fields``: the last step's whole fields."""
     from . import plots
 
-    record.write(settings.output, settings.json)
-    if settings.plot and not record.last_fields:  # every step taken from a file without fields
+    record.write(settings.output if with_h5 else "", settings.json)
+    if settings.plot and not fields:  # every step taken from a file without fields
         print(f"roughpetsc: -plot: no fields to plot in {settings.output} (-output_fields none)", file=sys.stderr)
     elif settings.plot:
-        plots.plot_solution(settings.plot, grid, record.last_fields["pressure"], record.last_fields["gap"],
-                            record.steps)
+        plots.plot_solution(settings.plot, grid, fields["pressure"], fields["gap"], record.steps)
 
 
 def step_line(step):
@@ -324,7 +343,8 @@ def solve_path(settings, solver, record, comm, say):
     """Solve the loads of ``settings.steps`` not yet in ``record``, recording each and checkpointing -output.
 
     Each step's pressure and gap are gathered on rank 0 for the record when
-    ``settings.gather_fields``. Every option must have been used once the
+    ``settings.gather_fields``, or kept as this rank's rows when every rank writes its rows of the
+    file (``record.first_row``). Every option must have been used once the
     first solve is done (PETSc reads viewers and converged reasons during and
     after TAOSolve); the check runs then, before any file is written.
     """
@@ -352,10 +372,19 @@ def solve_path(settings, solver, record, comm, say):
             check_unused(final=solver_ran)
             checked = solver_ran
         say(step_line(result.summary()))
-        gathered = [gather_rows(comm, field) for field in solver.fields()] if settings.gather_fields else [None, None]
-        record.add(dict(result.summary(), load_option=kind, load_value=value), result.history, *gathered)
+        if record.first_row is not None:
+            fields = [field.copy() for field in solver.fields()]
+        elif settings.gather_fields:
+            fields = [gather_rows(comm, field) for field in solver.fields()]
+        else:
+            fields = [None, None]
+        record.add(dict(result.summary(), load_option=kind, load_value=value), result.history, *fields)
         if settings.output and index < len(steps) - 1:  # every rank takes part: a failed write stops them all
-            io.on_root(comm, checkpoint, record, settings.output)
+            if record.first_row is not None:
+                if comm.bcast(record.due(), root=0):  # rank 0's clock decides for all
+                    record.write(settings.output, comm=comm)
+            else:
+                io.on_root(comm, checkpoint, record, settings.output)
 
 
 def checkpoint(record, h5_path):

@@ -4,12 +4,14 @@ Options are read only through ``PETSc.Options`` getters so that PETSc's
 ``-options_left`` reports unused or misspelled ones.
 """
 
+from dataclasses import dataclass
 import json
 
 import numpy as np
 
 from ..errors import UserError
 from ..io import atomic_path, check_figure_format, check_outputs, on_root
+from ..mode_settings import read_table
 
 OPTIONS = [
     ("models_alpha_h", 2.0, "bandwidth alpha^h of the surface (2.16), > 1.5"),
@@ -27,35 +29,46 @@ OPTIONS = [
 ]
 
 
-def _read(options):
-    o = {}
-    for name, default, _ in OPTIONS:
-        if isinstance(default, bool):
-            o[name] = options.getBool(name, default)
-        elif isinstance(default, int):
-            o[name] = options.getInt(name, default)
-        elif isinstance(default, float):
-            o[name] = options.getReal(name, default)
-        else:
-            o[name] = options.getString(name, default)
-    return o
+@dataclass(frozen=True)
+class ModelsSettings:
+    """What ``-mode models`` was asked to do; fields are named as the options of :data:`OPTIONS` are."""
+
+    models_alpha_h: float
+    models_alpha_p: float
+    models_n: int
+    models_dmax: float
+    models_pmax: float
+    models_kl: float
+    models_ks: float
+    models_hurst: float
+    models_m2: float
+    models_group: int
+    models_json: str
+    models_plot: str
+
+
+def read_settings(options):
+    """The :class:`ModelsSettings` of the options database, checked (:class:`UserError` naming the option)."""
+    settings = ModelsSettings(**read_table(options, OPTIONS))
+    _validate(settings)
+    return settings
 
 
 def _validate(o):
     for key in ("models_alpha_h", "models_alpha_p"):
-        if not np.isfinite(o[key]) or o[key] <= 1.5:
-            raise UserError("-%s must be a number > 1.5 (got %r)" % (key, o[key]))
-    if o["models_n"] < 2 or o["models_n"] > 100000:
-        raise UserError("-models_n must be between 2 and 100000 (got %r)" % o["models_n"])
+        if not np.isfinite(getattr(o, key)) or getattr(o, key) <= 1.5:
+            raise UserError("-%s must be a number > 1.5 (got %r)" % (key, getattr(o, key)))
+    if o.models_n < 2 or o.models_n > 100000:
+        raise UserError("-models_n must be between 2 and 100000 (got %r)" % o.models_n)
     for key in ("models_dmax", "models_pmax", "models_kl", "models_ks", "models_m2"):
-        if not np.isfinite(o[key]) or o[key] <= 0:
-            raise UserError("-%s must be positive and finite (got %r)" % (key, o[key]))
-    if o["models_ks"] <= o["models_kl"]:
+        if not np.isfinite(getattr(o, key)) or getattr(o, key) <= 0:
+            raise UserError("-%s must be positive and finite (got %r)" % (key, getattr(o, key)))
+    if o.models_ks <= o.models_kl:
         raise UserError("-models_ks must exceed -models_kl")
-    if not 0 < o["models_hurst"] < 1:
-        raise UserError("-models_hurst must lie in (0, 1) (got %r)" % o["models_hurst"])
+    if not 0 < o.models_hurst < 1:
+        raise UserError("-models_hurst must lie in (0, 1) (got %r)" % o.models_hurst)
     from .curvefit import TABLE_8_4
-    if o["models_group"] not in TABLE_8_4:
+    if o.models_group not in TABLE_8_4:
         raise UserError("-models_group must be one of %s" % sorted(TABLE_8_4))
 
 
@@ -63,9 +76,9 @@ def compute(o):
     """All curves as a plain dict (lists), dimensionless as in roughpetsc.models."""
     from . import (ALPHA_P_TABLE_8_3, COMPLETE_MODELS, EARLY_MODELS, TABLE_8_4,
                    complete, curvefit_area, early, persson_area, persson_gap)
-    ah, ap, n = o["models_alpha_h"], o["models_alpha_p"], o["models_n"]
-    d = np.linspace(o["models_dmax"], 0.0, n)
-    p = np.linspace(0.0, o["models_pmax"], n)
+    ah, ap, n = o.models_alpha_h, o.models_alpha_p, o.models_n
+    d = np.linspace(o.models_dmax, 0.0, n)
+    p = np.linspace(0.0, o.models_pmax, n)
     out = {"conventions": "d* = d/sqrt(m0^h), p* = pbar/sqrt(m0^p), g* = gbar/sqrt(m0^h)",
            "alpha_h": ah, "alpha_p": ap, "early": {}, "complete": {}}
     for name in EARLY_MODELS:
@@ -77,9 +90,9 @@ def compute(o):
     pp = p[p > 0]
     out["persson"] = {"pstar": p.tolist(), "A": persson_area(p).tolist(),
                       "gstar_pstar": pp.tolist(),
-                      "gstar": persson_gap(pp, o["models_kl"], o["models_ks"], o["models_hurst"],
-                                           o["models_m2"], 1.0).tolist()}
-    grp = o["models_group"]
+                      "gstar": persson_gap(pp, o.models_kl, o.models_ks, o.models_hurst,
+                                           o.models_m2, 1.0).tolist()}
+    grp = o.models_group
     b, c, dd = TABLE_8_4[grp]
     out["curvefit"] = {"group": grp, "b": b, "c": c, "d": dd, "alpha_p": ALPHA_P_TABLE_8_3[grp],
                        "pstar": p.tolist(),
@@ -117,12 +130,11 @@ def run(options, comm):
     The work is done on rank 0; its errors (files that cannot be written) are
     raised on every rank. Returns the curves on rank 0, None elsewhere.
     """
-    o = _read(options)
-    _validate(o)
-    on_root(comm, check_outputs, [("models_json", o["models_json"]), ("models_plot", o["models_plot"])],
+    o = read_settings(options)
+    on_root(comm, check_outputs, [("models_json", o.models_json), ("models_plot", o.models_plot)],
             options.getBool("overwrite", False))
-    if o["models_plot"]:  # after the path checks, which name a folder as such
-        check_figure_format(o["models_plot"], "models_plot")
+    if o.models_plot:  # after the path checks, which name a folder as such
+        check_figure_format(o.models_plot, "models_plot")
     curves = on_root(comm, _compute_and_write, o)
     from ..options import check_unused  # imports PETSc: only once the command line has initialised it
 
@@ -133,7 +145,7 @@ def run(options, comm):
 def _compute_and_write(o):
     """Compute, print and write the curves (rank 0)."""
     curves = compute(o)
-    print("models: alpha_h = %g, alpha_p = %g" % (o["models_alpha_h"], o["models_alpha_p"]))
+    print("models: alpha_h = %g, alpha_p = %g" % (o.models_alpha_h, o.models_alpha_p))
     print("%-16s %10s %10s %10s" % ("early model", "d*", "p*", "A*"))
     for name, c in curves["early"].items():
         for i in (0, len(c["dstar"]) // 2, -1):
@@ -142,12 +154,12 @@ def _compute_and_write(o):
     for name, c in curves["complete"].items():
         for i in (len(c["pstar"]) // 2, -1):
             print("%-16s %10.4f %10.4e %10.4e" % (name, c["pstar"][i], c["A"][i], c["gstar"][i]))
-    if o["models_json"]:
-        with atomic_path(o["models_json"]) as tmp:
+    if o.models_json:
+        with atomic_path(o.models_json) as tmp:
             with open(tmp, "w") as fh:
                 json.dump(curves, fh, indent=1)
-    if o["models_plot"]:
+    if o.models_plot:
         # The temporary name ends like the target, so matplotlib picks the same format.
-        with atomic_path(o["models_plot"]) as tmp:
+        with atomic_path(o.models_plot) as tmp:
             plot(curves, tmp)
     return curves

@@ -15,10 +15,11 @@ or the new complete file, and a full disk is one plain ``OSError`` of the byte w
 full disk itself leaves half-closed objects whose clean-up prints tracebacks of its own); the faults
 study (``studies/faults.py``) checks both.
 
-Parallel HDF5: the files are written by world rank 0 after the data are gathered to it. Writing
-collectively (``h5py.File(..., driver="mpio", comm=...)``) needs an h5py built against a parallel
-HDF5, which this installation does not have (``h5py.get_config().mpi`` is False); with one, only the
-field datasets of a load path would gain from it, the rest of each file is small.
+Parallel HDF5 (:func:`write_distributed`): where h5py is the parallel build (Debian's h5py takes it
+under mpiexec: ``h5py.get_config().mpi``), the field datasets of a load path, the only large part of
+any file, are written by every rank into its own rows (``driver="mpio"``, collective I/O) after rank 0
+has written the rest of the file, with those datasets created empty, to the temporary; rank 0 then
+renames it. Everything else is written by rank 0.
 """
 
 from io import BytesIO
@@ -48,6 +49,67 @@ def write(path, build):
         build(f)
     with atomic_path(path, durable=True) as temporary, open(temporary, "wb") as handle:
         handle.write(image.getbuffer())
+
+
+def parallel_hdf5(comm):
+    """True when ``comm`` (mpi4py) has several ranks and h5py can write one file from all of them."""
+    import h5py
+
+    return comm is not None and comm.Get_size() > 1 and bool(h5py.get_config().mpi)
+
+
+def write_distributed(path, comm, build, distributed):
+    """Write an HDF5 file atomically from every rank of ``comm``: :func:`write`, with datasets spread over the ranks.
+
+    Parameters
+    ----------
+    path, build :
+        As for :func:`write`; ``build`` runs on rank 0 and must create each dataset of ``distributed``
+        empty (its shape and type; no compression, which parallel writes do not allow here).
+    comm : mpi4py.MPI.Comm
+        Every rank calls this function (:func:`parallel_hdf5` is True).
+    distributed : dict of name -> (local rows, first row)
+        Each rank's block of rows of a dataset, written collectively.
+
+    Raises :class:`roughpetsc.errors.UserError` naming ``path``, on every rank, if the file cannot be written.
+    """
+    import h5py
+
+    from ..errors import UserError
+
+    target, temporary, message = None, None, None
+    if comm.Get_rank() == 0:
+        try:
+            image = BytesIO()
+            with h5py.File(image, "w") as f:
+                build(f)
+            target = atomic_path(path, durable=True)
+            temporary = target.__enter__()
+            with open(temporary, "wb") as handle:
+                handle.write(image.getbuffer())
+        except (UserError, OSError) as error:
+            message = str(error) if isinstance(error, UserError) else f"cannot write {path}: {error}"
+    temporary, message = comm.bcast((temporary, message), root=0)
+    if message is None:
+        try:
+            with h5py.File(temporary, "r+", driver="mpio", comm=comm) as f:
+                for name, (rows, first) in distributed.items():
+                    dataset = f[name]
+                    with dataset.collective:
+                        dataset[first:first + rows.shape[0]] = rows
+        except OSError as error:
+            message = f"cannot write {path}: {error}"
+        messages = comm.allgather(message)
+        message = next((m for m in messages if m), None)
+    if comm.Get_rank() == 0 and target is not None:
+        try:
+            failure = (UserError, UserError(message), None) if message else (None, None, None)
+            target.__exit__(*failure)
+        except UserError as error:
+            message = message or str(error)
+    message = comm.bcast(message, root=0)
+    if message:
+        raise UserError(message)
 
 
 def attribute(value):

@@ -3,8 +3,9 @@
 Layout::
 
     /                  attrs: the run's summary (grid, length, E_star, surface, surface_parameters,
-                              sqrt_m0h, sqrt_m0p, solver, control, kkt_rtol, ranks, command, options,
-                              versions); nested values as JSON text
+                              sqrt_m0h, sqrt_m0p, solver, control, kkt_rtol, boundary, hardness, ranks,
+                              command, options, versions; nested values as JSON text) and
+                              fields_written_by_every_rank (parallel HDF5, roughpetsc.store)
     /heights           (n0, n1) the whole surface, length units
     /pressure, /gap    (n0, n1) of the last step (unless -output_fields none)
     /steps/NNN         attrs: that step's results (:meth:`roughpetsc.contact.Result.summary` with
@@ -20,7 +21,7 @@ Every dataset of a name carries the units and description of :data:`DATASET_ATTR
 
 import numpy as np
 
-from . import attribute, from_attribute, set_attributes, write as write_file
+from . import attribute, from_attribute, set_attributes, write as write_file, write_distributed
 
 DATASET_ATTRIBUTES = {
     "heights": {"units": "length",
@@ -48,7 +49,7 @@ def _field(group, name, array):
     dataset.attrs.update(DATASET_ATTRIBUTES.get(name, {}))
 
 
-def write(path, summary, fields=None, histories=None, step_fields=None, stresses=()):
+def write(path, summary, fields=None, histories=None, step_fields=None, stresses=(), comm=None, first_row=None):
     """Write a load path's file (atomically, :func:`roughpetsc.store.write`).
 
     Parameters
@@ -62,9 +63,24 @@ def write(path, summary, fields=None, histories=None, step_fields=None, stresses
         Fields kept per step (``-output_fields all``).
     stresses : sequence of roughpetsc.stresses.DepthStresses
         The last step's subsurface stresses, one entry per depth (``-stress_depths``).
+    comm, first_row :
+        With ``first_row`` (this rank's first row), the pressure and gap fields of ``fields`` and
+        ``step_fields`` are this rank's rows only, and every rank of ``comm`` calls this function: the
+        fields are written in parallel (:func:`roughpetsc.store.write_distributed`); ``heights`` is whole.
     """
+    distributed = {}
+    if first_row is not None:
+        shape = fields["heights"].shape
+        local = {name: array for name, array in fields.items() if name in FIELD_NAMES}
+        distributed.update({name: (array, first_row) for name, array in local.items()})
+        for index, arrays in (step_fields or {}).items():
+            distributed.update({f"steps/{index:03d}/{name}": (array, first_row) for name, array in arrays.items()})
+        fields = {name: array for name, array in fields.items() if name not in FIELD_NAMES}
+        step_fields = {}
+
     def build(f):
         set_attributes(f, {key: value for key, value in summary.items() if key != "steps"})
+        f.attrs["fields_written_by_every_rank"] = bool(distributed)
         for index, step in enumerate(summary.get("steps", [])):
             group = f.create_group(f"steps/{index:03d}")
             set_attributes(group, step)
@@ -76,6 +92,10 @@ def write(path, summary, fields=None, histories=None, step_fields=None, stresses
                 _field(group, name, array)
         for name, array in (fields or {}).items():
             _field(f, name, array)
+        for name in distributed:  # created empty; every rank writes its rows
+            dataset = f.require_group(name.rpartition("/")[0] or "/").create_dataset(
+                name.rpartition("/")[2], shape=shape, dtype="float64")
+            dataset.attrs.update(DATASET_ATTRIBUTES.get(name.rpartition("/")[2], {}))
         for index, depth in enumerate(stresses):
             group = f.create_group(f"stresses/{index:02d}")
             group.attrs.update(depth=depth.depth, max_von_mises=depth.max_von_mises,
@@ -83,7 +103,10 @@ def write(path, summary, fields=None, histories=None, step_fields=None, stresses
             for name, array in dict(depth.components, von_mises=depth.von_mises).items():
                 _field(group, name, array)
 
-    write_file(path, build)
+    if distributed:
+        write_distributed(path, comm, build, distributed)
+    else:
+        write_file(path, build)
 
 
 def read(path):
