@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import ParameterError
+from .fftw import planner_effort
 
 COMPONENTS = ("xx", "yy", "zz", "xy", "yz", "xz")
 
@@ -105,17 +106,30 @@ def periodic_stresses(pressure, lengths, depths, nu):
     DepthStresses
         One per depth, in the order given; only one depth's fields are held at a time.
     """
+    import pyfftw
+
     depths = check_depths(depths)
     check_poisson(nu)
     n0, n1 = pressure.shape
+    # One forward transform for all depths, one inverse per component and depth, on FFTW plans made once.
+    real = pyfftw.empty_aligned((n0, n1), dtype="float64")
+    spectrum = pyfftw.empty_aligned((n0, n1 // 2 + 1), dtype="complex128")
+    effort = planner_effort("FFTW_ESTIMATE")
+    forward = pyfftw.FFTW(real, spectrum, axes=(0, 1), flags=(effort,))
+    backward = pyfftw.FFTW(spectrum, real, axes=(0, 1), direction="FFTW_BACKWARD",
+                           flags=(effort, "FFTW_DESTROY_INPUT"))
+    real[...] = pressure
+    forward.execute()
+    pressure_spectrum = spectrum / (n0 * n1)  # the unnormalised pair's 1 / (n0 n1)
     k0 = np.fft.fftfreq(n0, d=lengths[0] / n0)[:, None]
     k1 = np.fft.rfftfreq(n1, d=lengths[1] / n1)[None, :]
-    spectrum = np.fft.rfft2(pressure)
     uniform = uniform_state(float(pressure.mean()), nu)
     for depth in depths:
-        transfer = transfer_functions(k0, k1, depth, nu)
-        components = {name: np.fft.irfft2(spectrum * transfer[name], s=(n0, n1)) + uniform[name]
-                      for name in COMPONENTS}
+        components = {}
+        for name, transfer in transfer_functions(k0, k1, depth, nu).items():
+            np.multiply(pressure_spectrum, transfer, out=spectrum)
+            backward.execute()
+            components[name] = real + uniform[name]
         equivalent = von_mises(components)
         location = np.unravel_index(int(np.argmax(equivalent)), equivalent.shape)
         yield DepthStresses(float(depth), components, equivalent, float(equivalent[location]),

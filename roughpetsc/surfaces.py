@@ -90,25 +90,43 @@ def check_fractal_parameters(grid, k_l, k_s, hurst, m2):
         raise ParameterError("k_l", f"the cut-off k_l={k_l} is below the fundamental wavenumber of the cell")
 
 
-def fractal(grid, k_l, k_s, hurst, m2, seed):
-    """Gaussian isotropic self-affine surface of section 7.1.
+GENERATORS = ("filter", "xu")
+
+
+def fractal(grid, k_l, k_s, hurst, m2, seed, generator="filter"):
+    """Gaussian isotropic self-affine surface of section 7.1, with the PSD (2.18) (k_r = k_l, C from (7.1)).
 
     White Gaussian noise (unit variance, one sample per node, drawn from
-    ``numpy.random.default_rng(seed)``) is filtered in Fourier space by
-    ``sqrt(S(k) n0 n1 / A0)`` so that the expected discrete spectrum equals the
-    PSD (2.18) (with k_r = k_l and C from (7.1)); the Hermitian symmetry (7.5)
-    holds because the noise is real. The result is the same array on every MPI
-    rank: each rank computes the whole surface and keeps its rows.
+    ``numpy.random.default_rng(seed)``) is transformed and shaped in Fourier space:
+
+    * ``generator="filter"``: multiplied by ``sqrt(S(k) n0 n1 / A0)``, so that the *expected* discrete
+      spectrum is the PSD; the amplitude of each mode is random, as the noise's.
+    * ``generator="xu"``: (7.2)-(7.5) of the dissertation (Xu and Jackson's algorithm): divided by the
+      noise's own spectrum (its modulus, ``S[h0]`` of (7.4)) and multiplied by the same factor, so that
+      every realisation carries the prescribed amplitude ``sqrt(S(k))`` exactly and only the phase (that
+      of the noise, uniform and Hermitian-symmetric; the random phase theta of (7.5) is absorbed in it)
+      is random. Spectral moments are then the same for every seed.
+
+    The Hermitian symmetry (7.5) holds because the noise is real. The result is the same array on every
+    MPI rank: each rank computes the whole surface and keeps its rows.
 
     Returns
     -------
     ndarray, shape (n0, n1): heights with zero mean, length units.
     """
     check_fractal_parameters(grid, k_l, k_s, hurst, m2)
+    if generator not in GENERATORS:
+        raise ParameterError("generator", f"the surface generator is one of {', '.join(GENERATORS)}, "
+                                          f"got '{generator}'")
     amplitude = fractal_amplitude(k_l, k_s, hurst, m2)
     noise = np.random.default_rng(seed).standard_normal(grid.shape)
     spectrum = np.fft.rfft2(noise)
     del noise
+    if generator == "xu":
+        # The noise's expected |F|^2 is n0 n1: dividing by |F| and multiplying by sqrt(n0 n1) keeps the
+        # scale of the filter, so both generators have the same expected moments.
+        modulus = np.abs(spectrum)
+        spectrum *= np.where(modulus > 0, np.sqrt(grid.size) / np.where(modulus > 0, modulus, 1.0), 0.0)
     k0, k1 = grid.rfft_wavenumbers()
     k = np.hypot(k0, k1)
     spectrum *= np.sqrt(fractal_psd(k, k_l, k_s, hurst, amplitude) * grid.size / grid.area)
@@ -251,6 +269,8 @@ SURFACE_OPTIONS = [
     ("surface_H", 0.8, "fractal: Hurst exponent H in (0, 1)"),
     ("surface_m2", 2e-4, "fractal: prescribed m2^h (mean square slope along x), sets C by (7.1)"),
     ("surface_seed", 1, "fractal: seed of the white noise (same surface on any number of ranks)"),
+    ("surface_generator", "filter", "fractal: filter (white noise filtered by sqrt(PSD): random amplitudes) | xu "
+                                    "((7.2)-(7.5): exact amplitude sqrt(PSD), random phase; the group presets')"),
     ("surface_amplitude", 0.01, "bisinusoid: Delta of (3.52); wave: h of 2h sin^2(pi x/lambda) [length]"),
     ("surface_wavelength", 0.0, "bisinusoid/wave: wavelength along x (0 = the cell length)"),
     ("surface_radius", 10.0, "sphere: radius R of the paraboloid -r^2/(2R) [length]"),
@@ -259,7 +279,7 @@ SURFACE_OPTIONS = [
 
 # The options each surface type reads besides the grid (-surface_N, -surface_N0, -surface_L).
 TYPE_OPTIONS = {
-    "fractal": ("surface_kl", "surface_ks", "surface_H", "surface_m2", "surface_seed"),
+    "fractal": ("surface_kl", "surface_ks", "surface_H", "surface_m2", "surface_seed", "surface_generator"),
     "bisinusoid": ("surface_amplitude", "surface_wavelength"),
     "wave": ("surface_amplitude", "surface_wavelength"),
     "sphere": ("surface_radius",),
@@ -267,7 +287,7 @@ TYPE_OPTIONS = {
 
 # The keyword of :func:`fractal` that each fractal option sets.
 FRACTAL_KEYWORDS = {"surface_kl": "k_l", "surface_ks": "k_s", "surface_H": "hurst", "surface_m2": "m2",
-                    "surface_seed": "seed"}
+                    "surface_seed": "seed", "surface_generator": "generator"}
 
 
 def option_values(opts, names):

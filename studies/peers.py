@@ -134,13 +134,16 @@ def run_ours(grid, heights, pairs, previous, pstar, rtol, repeats):
     return best, field
 
 
-def run_peer(peer, surface_path, pbar, tol, workdir, timeout):
+def run_peer(peer, surface_path, pbar, tol, workdir, timeout, hardness=None):
+    """Solve with ``peer`` in its own virtualenv: (its JSON summary, its pressure field)."""
     prefix = os.path.join(workdir, f"{peer}_{tol:.0e}")
     env = dict(os.environ)
     for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "FFTW_NUM_THREADS"):
         env[name] = "1"
     env.pop("PYTHONPATH", None)
     command = [PEER_PYTHON, RUN_PEER, surface_path, "1.0", repr(pbar), peer, repr(tol), prefix]
+    if hardness is not None:
+        command += ["--hardness", repr(hardness)]
     completed = subprocess.run(command, cwd=workdir, env=env, capture_output=True, text=True, timeout=timeout)
     if completed.returncode != 0:
         raise RuntimeError(f"{peer} at tol {tol:g} failed:\n{completed.stderr[-3000:]}")

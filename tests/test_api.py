@@ -52,9 +52,10 @@ def test_fractal_group_one_is_the_embedded_default():
     from roughpetsc.surfaces import SURFACE_OPTIONS
 
     defaults = {name: default for name, default, _ in SURFACE_OPTIONS}
+    # The embedded default surface has group 1's PSD; the group presets take the dissertation's generator.
     assert fractal_group(1) == {"k_l": defaults["surface_kl"], "k_s": defaults["surface_ks"],
                                 "hurst": defaults["surface_H"], "m2": defaults["surface_m2"],
-                                "n": 1024, "length": defaults["surface_L"]}
+                                "n": 1024, "length": defaults["surface_L"], "generator": "xu"}
 
 
 def test_bad_parameters_are_named_physically():

@@ -283,3 +283,30 @@ def test_table_8_groups_bandwidths(k_l, k_s, hurst, n, seeds, alpha_h_seed, alph
     summaries = ensemble_summaries(k_l, k_s, hurst, n, seeds)
     assert np.mean([s["alpha_h"] for s in summaries]) == pytest.approx(alpha_h_seed, rel=0.03)
     assert np.mean([s["alpha_p"] for s in summaries]) == pytest.approx(alpha_p_seed, rel=0.03)
+
+
+def test_xu_generator_has_the_prescribed_amplitude_in_every_realisation():
+    """(7.2)-(7.5): |F[h]| = sqrt(S(k) n0 n1 / A0) for every seed, so the spectral moments do not vary;
+    the filter's amplitudes are random, with the same expected moments."""
+    from roughpetsc.surfaces import Grid, fractal, fractal_amplitude, fractal_psd
+
+    grid = Grid(128, 128)
+    k0, k1 = grid.rfft_wavenumbers()
+    expected = np.sqrt(fractal_psd(np.hypot(k0, k1), 4, 32, 0.8, fractal_amplitude(4, 32, 0.8, 2e-4))
+                       * grid.size / grid.area) * np.sqrt(grid.size)
+    expected[0, 0] = 0.0
+    moments = {"xu": [], "filter": []}
+    for seed in range(6):
+        for generator in moments:
+            heights = fractal(grid, 4, 32, 0.8, 2e-4, seed, generator=generator)
+            if generator == "xu":
+                assert np.allclose(np.abs(np.fft.rfft2(heights)), expected, rtol=1e-10, atol=1e-12 * expected.max())
+            moments[generator].append(spectra.spectral_moments(grid, heights)["x"][2])
+    assert np.std(moments["xu"]) < 1e-12 * np.mean(moments["xu"])
+    assert np.std(moments["filter"]) > 1e-3 * np.mean(moments["filter"])
+    assert np.mean(moments["filter"]) == pytest.approx(np.mean(moments["xu"]), rel=0.1)
+    # The same seed, the same phases: the two generators differ only in the amplitudes.
+    a = np.fft.rfft2(fractal(grid, 4, 32, 0.8, 2e-4, 3, generator="xu"))
+    b = np.fft.rfft2(fractal(grid, 4, 32, 0.8, 2e-4, 3, generator="filter"))
+    inside = expected > 0
+    assert np.allclose(np.angle(a[inside] * np.conj(b[inside])), 0.0, atol=1e-9)

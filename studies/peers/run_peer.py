@@ -10,7 +10,7 @@ setup wall time, versions, the peer's own error measure).
 
 It never imports roughpetsc: the peers live in their own virtualenv with their own numpy.
 
-Both peers are set up on OUR discrete problem (SPEC 1, eq. 3.33): a periodic
+Both peers are set up on OUR discrete problem (docs/conventions.md, eq. 3.33): a periodic
 square cell of side L, the Westergaard compliance u_hat = p_hat / (pi E* |k|)
 with k in cycles per length, no displacement for the k = 0 mode; gap
 g = u + d - h with the heights h of the file as the rough surface.
@@ -115,7 +115,7 @@ class _CaptureStderr:
         return False
 
 
-def solve_contactmechanics(heights, e_star, pbar, tol, length, max_iter):
+def solve_contactmechanics(heights, e_star, pbar, tol, length, max_iter, hardness=None):
     import ContactMechanics
     from ContactMechanics import PeriodicFFTElasticHalfSpace
     from ContactMechanics.Optimization import constrained_conjugate_gradients  # noqa: F401
@@ -139,8 +139,10 @@ def solve_contactmechanics(heights, e_star, pbar, tol, length, max_iter):
 
     setup = time.perf_counter() - start
     start, cpu = time.perf_counter(), time.process_time()
-    result = ccg(substrate, topography, external_force=external_force, pentol=pentol, forcetol=forcetol,
-                 thermotol=tol, maxiter=max_iter, callback=callback)
+    # CCG's hardness caps the force of a pixel: the pressure cap times the area of a pixel.
+    cap = None if hardness is None else hardness * substrate.area_per_pt
+    result = ccg(substrate, topography, hardness=cap, external_force=external_force, pentol=pentol,
+                 forcetol=forcetol, thermotol=tol, maxiter=max_iter, callback=callback)
     solve_time, cpu = time.perf_counter() - start, time.process_time() - cpu
     pressure = np.asarray(result.jac, dtype=np.float64) / substrate.area_per_pt
     return {
@@ -154,7 +156,8 @@ def solve_contactmechanics(heights, e_star, pbar, tol, length, max_iter):
         "cpu_s": cpu,
         "version": _version("ContactMechanics", ContactMechanics.__version__),
         "settings": {"tolerance": tol, "pentol": pentol, "forcetol": forcetol, "thermotol": tol,
-                     "maxiter": max_iter, "external_force": external_force, "stiffness_q0": 0.0},
+                     "maxiter": max_iter, "external_force": external_force, "stiffness_q0": 0.0,
+                     "hardness": hardness},
     }
 
 
@@ -192,6 +195,8 @@ def main():
     parser.add_argument("out", nargs="?", help="output prefix (.npy and .json are added)")
     parser.add_argument("--length", type=float, default=1.0, help="cell side along axis 0 (default 1)")
     parser.add_argument("--max-iter", type=int, default=100000)
+    parser.add_argument("--hardness", type=float, default=None,
+                        help="contactmechanics only: the pressure cap H (perfect plasticity, CCG's hardness)")
     parser.add_argument("--check-kernels", action="store_true",
                         help="only compare both peers' compliance with 1/(pi E* |k|) and exit")
     args = parser.parse_args()
@@ -203,8 +208,13 @@ def main():
     heights = np.load(args.surface)
     if heights.ndim != 2 or not np.all(np.isfinite(heights)):
         sys.exit(f"{args.surface}: need a finite 2-D height array")
-    solve = solve_tamaas if args.peer == "tamaas" else solve_contactmechanics
-    result = solve(heights, args.e_star, args.pbar, args.tol, args.length, args.max_iter)
+    if args.peer == "tamaas":
+        if args.hardness is not None:
+            sys.exit("--hardness: only with contactmechanics")
+        result = solve_tamaas(heights, args.e_star, args.pbar, args.tol, args.length, args.max_iter)
+    else:
+        result = solve_contactmechanics(heights, args.e_star, args.pbar, args.tol, args.length, args.max_iter,
+                                        args.hardness)
     pressure = result.pop("pressure")
     in_contact = pressure > 0
     result.update({
