@@ -70,10 +70,10 @@ def test_datasets_carry_units_and_the_surface_parameters_are_recorded(tmp_path):
         for name in ("heights", "pressure", "gap", "steps/000/history"):
             assert f[name].attrs["description"]
         parameters = json.loads(f.attrs["surface_parameters"])
-    # Defaults included: type, H, m2 and seed were not given.
+    # Defaults included: type, H, m2, seed and generator were not given.
     assert parameters == {"surface_type": "fractal", "surface_N": 64, "surface_N0": 0, "surface_L": 1.0,
                           "surface_kl": 4.0, "surface_ks": 16.0, "surface_H": 0.8, "surface_m2": 2e-4,
-                          "surface_seed": 1}
+                          "surface_seed": 1, "surface_generator": "filter"}
 
 
 def test_a_path_out_of_time_keeps_its_steps_and_resumes(tmp_path):
