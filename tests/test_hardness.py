@@ -58,7 +58,9 @@ def dense_reference(grid, heights, problem, separation):
 def test_every_solver_meets_the_dense_reference(capped, tao_type, control):
     problem, reference, separation = capped
     assert (reference >= problem.upper_bound * (1 - 1e-9)).mean() > 0.05  # the cap binds
-    solver = Solver(problem, control, tao_type, 1e-10)
+    # 1e-9: above the round-off floors of the quasi-Newton types (1e-10 to 2e-10, README), which depend on the
+    # machine's FFT plans; the reference itself is good to about 1e-7 of the cap.
+    solver = Solver(problem, control, tao_type, 1e-9)
     try:
         if control == "displacement":
             result = solver.solve(gbar=separation * problem.height_scale)
