@@ -213,6 +213,16 @@ class Westergaard(FilterOperator):
         # rfft layout: a column that stands for two modes of the full spectrum counts twice.
         return float((symbol * rfft_multiplicity(self.grid.n1)).sum() / self.grid.size)
 
+    @log_event("RPStiffness")
+    def elastic_pressure(self, displacement, out):
+        """``out = F^-1[pi E* |k| F[displacement]]``: the pressure less its mean that makes ``displacement``.
+
+        The exact inverse of the compliance on the zero-mean fields (the adhesive gap formulation's
+        Hessian); counts as an application.
+        """
+        self.applications += 1
+        self._filter(self.local(displacement, readonly=True), self.local(out), self._stiffness)
+
     def pressure_surface(self, heights, out):
         """``out = F^-1[pi E* |k| F[heights]]``: the complete-contact pressure p_c of (2.47)."""
         self._filter(self.local(heights, readonly=True), self.local(out), self._stiffness)

@@ -1,0 +1,191 @@
+"""Adhesive contact of a rough surface and a rigid flat in the periodic BEM, the gap as the unknown.
+
+With an interaction law phi (:mod:`roughpetsc.interaction`) the total energy per unit area of a gap
+field g >= 0 at the mean gap gbar (the rigid separation, (3.38)) is
+
+    Pi(g) = 1/2 <g + h, S (g + h)> + <phi(g)>,
+
+``<.>`` the mean over the nodes and ``S`` the stiffness (the inverse symbol pi E* |k| of the Westergaard
+compliance (3.33), zero at k = 0): the surface displacement is u = g - gbar + h and S kills constants.
+The gap stays bound-constrained; the mean gap is the one equality (displacement control). Adhesive
+contact is unstable under load control (it jumps in and out of contact), so paths run under
+displacement control and the load is an output.
+
+First-order conditions, with r = S (g + h) + phi'(g) and a multiplier lambda = -pbar (pbar the mean
+pressure, compressive positive):
+
+* out of contact (g > 0): r = lambda, i.e. the total pressure p = S(g + h) + pbar equals the law's
+  traction -phi'(g);
+* in contact (g = 0): the contact pressure c = r - lambda >= 0.
+
+The natural residual certified after every solve is ``max |min(g / sqrt(m0^h), (r - lambda) /
+sqrt(m0^p))|`` over all nodes, on a gap whose S g is computed afresh, with lambda the mean of r out of
+contact (the best multiplier for those nodes). Its pressure scale sqrt(m0^p) (2.52) is that of the
+non-adhesive problem (the mean pressure may be zero or tensile here).
+
+Only the periodic boundary is supported (the free boundary's stiffness is not a Fourier filter).
+"""
+
+import math
+import time
+
+import numpy as np
+
+from .contact import Result, measure
+from .errors import ParameterError
+from .kkt import KKTReport, allsum, allmin
+from .solvers.gap_cg import gap_cg
+
+
+class AdhesiveContact:
+    """A :class:`~roughpetsc.contact.ContactProblem` with an adhesive law, solved for the gap.
+
+    Parameters
+    ----------
+    problem : ContactProblem
+        Periodic, without a hardness cap.
+    law : interaction.Dugdale or interaction.Exponential
+        In the problem's units (pressure units of E*, length units of the heights).
+    rtol : float
+        Tolerance on the natural residual (module docstring).
+    max_iter : int
+    max_seconds : float
+        Seconds after which a solve stops, reported as a time limit (0: none).
+
+    Attributes
+    ----------
+    gap : petsc4py.PETSc.Vec
+        The scaled gap of the last solve, the start of the next.
+    """
+
+    def __init__(self, problem, law, rtol=1e-8, max_iter=20000, max_seconds=0.0):
+        if problem.boundary != "periodic":
+            raise ParameterError("boundary", "adhesion is solved on the periodic cell only")
+        if problem.upper_bound is not None:
+            raise ParameterError("hardness", "adhesion and a hardness cap cannot be combined yet")
+        self.problem = problem
+        self.law = law
+        self.scaled_law = law.scaled(problem.height_scale, problem.pressure_scale)
+        self.rtol = rtol
+        self.max_iter = max_iter
+        self.max_seconds = max_seconds
+        self.gap = problem.vec()
+        self.elastic = problem.vec()  # S g + p_c = S (g + h)
+        self.pressure_scale = math.sqrt(problem.m0p_scaled)
+        self.started = False
+        self.name = "gapcg"
+
+    def destroy(self):
+        self.gap.destroy()
+        self.elastic.destroy()
+
+    # --- the energy and its gradient ------------------------------------------
+    def elastic_pressure(self, gap_vec, out):
+        """``out = S (g + h)``: the elastic pressure less its mean (one operator application)."""
+        self.problem.operator.elastic_pressure(gap_vec, out)
+        out.axpy(1.0, self.problem.pressure_surface)
+
+    def stationarity(self, g, elastic):
+        """``(r, lambda, natural, report)`` of local arrays ``g`` and ``elastic`` = S (g + h) (module docstring)."""
+        mpi = self.problem.mpi
+        r = elastic + self.scaled_law.force(g)
+        out_of_contact = g > 0
+        count, r_sum = allsum(mpi, [np.count_nonzero(out_of_contact), r.sum(where=out_of_contact)])
+        lam = r_sum / count if count else 0.0
+        scale = self.pressure_scale
+        excess = (r - lam) / scale
+        natural_local = np.max(np.abs(np.minimum(g, excess)), initial=0.0)
+        in_contact = ~out_of_contact
+        min_c = np.min(excess, where=in_contact, initial=np.inf)
+        equilibrium = np.abs(excess, where=out_of_contact, out=np.zeros_like(excess))
+        natural, neg_min_c, neg_min_g = -allmin(mpi, [-natural_local, min_c, g.min()]) * [1, -1, -1]
+        complementarity, = allsum(mpi, [np.dot(equilibrium.ravel(), g.ravel())])
+        kkt = KKTReport(natural=float(natural), complementarity=float(complementarity / self.problem.n),
+                        min_p=float(neg_min_c) if np.isfinite(neg_min_c) else 0.0, min_g=float(neg_min_g))
+        return r, lam, kkt
+
+    def energy(self, g, elastic):
+        """Pi(g) (scaled, per unit area) of local arrays ``g`` and ``elastic`` = S (g + h)."""
+        h = self.problem.local(self.problem.heights, readonly=True)
+        sums = allsum(self.problem.mpi, [0.5 * np.dot((g + h).ravel(), elastic.ravel()),
+                                         self.scaled_law.energy(g).sum()])
+        return float(sums.sum() / self.problem.n)
+
+    # --- solves ---------------------------------------------------------------
+    def solve(self, gbar):
+        """Solve at the mean gap ``gbar`` (length units) from the last solution; a :class:`Result`.
+
+        The first solve starts from the rigid gap max(gbar - h, 0) shifted to mean gbar; later ones from
+        the previous gap shifted by the change of gbar (both projected onto g >= 0, mean gbar).
+        """
+        if not (gbar > 0 and math.isfinite(gbar)):
+            raise ParameterError("gbar", f"the mean gap must be positive and finite, got {gbar}")
+        problem = self.problem
+        target = gbar / problem.height_scale
+        g = problem.local(self.gap)
+        if not self.started:
+            g[...] = target - problem.local(problem.heights, readonly=True)
+            self.started = True
+        else:
+            current, = allsum(problem.mpi, [g.sum()])
+            g += target - current / problem.n
+        start = time.perf_counter()
+        applications = problem.operator.applications
+        outcome = gap_cg(self, target)
+        return self._result(outcome, target, start, applications)
+
+    def _result(self, outcome, target, start, applications):
+        problem = self.problem
+        self.elastic_pressure(self.gap, self.elastic)
+        g = problem.local(self.gap, readonly=True)
+        elastic = problem.local(self.elastic, readonly=True)
+        _, lam, kkt = self.stationarity(g, elastic)
+        converged = kkt.natural <= self.rtol
+        reason = outcome.reason
+        if not converged and reason.startswith("CONVERGED"):
+            reason = f"NOT_CERTIFIED ({reason}, but on a fresh S g: natural residual {kkt.natural:.2g})"
+        in_contact = (g == 0).astype(np.float64)
+        measures = measure(problem, in_contact, g)
+        pbar = -lam * problem.pressure_scale
+        gbar = target * problem.height_scale
+        return Result(
+            pbar=pbar, pstar=pbar / problem.sqrt_m0p, A=measures["A"], A_corrected=measures["A_corrected"],
+            gbar=gbar, gstar=target, separation=gbar, rms_gap_contact=0.0, kkt=kkt,
+            iterations=outcome.iterations, operator_applications=problem.operator.applications - applications,
+            time_s=time.perf_counter() - start, reason=reason, converged=converged, solver=self.name,
+            control="displacement", history=outcome.history)
+
+    def fields(self, pbar):
+        """This rank's rows of the total pressure (compressive positive) and the gap, physical units.
+
+        ``pbar`` is the mean pressure of the last result (pressure units). The pressure is
+        S (g + h) + pbar: the contact pressure in contact, the law's traction -phi'(g) out of it.
+        """
+        problem = self.problem
+        pressure = problem.local(self.elastic, readonly=True) * problem.pressure_scale + pbar
+        return pressure, problem.local(self.gap, readonly=True) * problem.height_scale
+
+    def path(self, gbars):
+        """A generator of Results along the mean gaps ``gbars`` (length units), each warm-started."""
+        for gbar in gbars:
+            yield self.solve(gbar)
+
+
+def approach_retraction(gbar_max, gbar_min, steps):
+    """Mean gaps from ``gbar_max`` down to ``gbar_min`` and back up, ``steps`` each way (length units).
+
+    The turning point appears once; a path along it shows the hysteresis of adhesive contact.
+    """
+    down = np.linspace(gbar_max, gbar_min, steps + 1)
+    return np.concatenate([down, down[-2::-1]])
+
+
+def dissipated_energy(gbars, pbars):
+    """Energy dissipated per unit area in one approach-retraction cycle: -closed integral of pbar dgbar.
+
+    d Pi / d gbar = -pbar along every equilibrium branch, so the work -integral pbar dgbar put in
+    around a closed cycle is what the jumps in and out of contact dissipated. Trapezoids over the
+    path (pressure x length units); positive for a hysteresis loop.
+    """
+    gbars, pbars = np.asarray(gbars), np.asarray(pbars)
+    return float(-np.sum(0.5 * (pbars[1:] + pbars[:-1]) * np.diff(gbars)))

@@ -1,0 +1,134 @@
+"""Adhesive interaction laws: an energy per unit area phi(g) of the local gap g >= 0.
+
+The adhesive contact problem adds ``sum phi(g) dA`` to the elastic energy (chapter 6 of the
+dissertation treats the same laws in its closed-form models): ``phi(0) = -w`` with ``w`` the work of
+adhesion (energy per unit area, pressure x length units) and ``phi -> 0`` beyond the range of the
+law. ``force(g) = phi'(g) >= 0`` is the magnitude of the attractive (tensile) stress the law exerts at
+gap g; ``curvature(g) = phi''(g)``.
+
+Laws
+----
+``Dugdale(work, stress)``
+    The Maugis-Dugdale law: a constant tensile stress sigma0 up to the range h0 = w / sigma0,
+    ``phi = -w + sigma0 g`` for g < h0, 0 beyond (Maugis, J. Colloid Interface Sci. 150, 1992).
+``Exponential(work, range_)``
+    ``phi = -w exp(-g / rho)``: peak stress w / rho at contact (Rey, Anciaux and Molinari, Comput. Mech.
+    60, 2017 use it for rough surfaces).
+"""
+
+import math
+
+import numpy as np
+
+from .errors import ParameterError
+
+LAWS = ("none", "dugdale", "exponential")
+
+
+def _positive(name, value, what):
+    if not (value is not None and value > 0 and math.isfinite(value)):
+        raise ParameterError(name, f"the {what} must be positive and finite, got {value}")
+    return float(value)
+
+
+class Dugdale:
+    """The Maugis-Dugdale law: tensile stress ``stress`` (pressure units) up to the range w / stress."""
+
+    name = "dugdale"
+
+    def __init__(self, work, stress):
+        self.work = _positive("adhesion_work", work, "work of adhesion")
+        self.stress = _positive("adhesion_stress", stress, "Dugdale stress")
+        self.range = self.work / self.stress
+
+    @property
+    def peak_stress(self):
+        return self.stress
+
+    def scaled(self, length, pressure):
+        """The same law in units where lengths are ``length`` and pressures ``pressure``."""
+        return Dugdale(self.work / (length * pressure), self.stress / pressure)
+
+    def energy(self, gap):
+        return np.minimum(self.stress * gap - self.work, 0.0)
+
+    def energy_change(self, gap, trial):
+        """``phi(trial) - phi(gap)`` node by node, as sigma0 (min(trial, h0) - min(gap, h0)) (no w to cancel)."""
+        return self.stress * (np.minimum(trial, self.range) - np.minimum(gap, self.range))
+
+    def force(self, gap, out=None):
+        return np.multiply(np.less(gap, self.range), self.stress, out=out)
+
+    def curvature(self, gap):
+        return np.zeros_like(gap)
+
+    def describe(self):
+        return f"Dugdale law: w = {self.work:.6g}, sigma0 = {self.stress:.6g}, range h0 = {self.range:.6g}"
+
+
+class Exponential:
+    """``phi = -w exp(-g / rho)``: work ``work``, range ``range_`` (length units), peak stress w / rho."""
+
+    name = "exponential"
+
+    def __init__(self, work, range_):
+        self.work = _positive("adhesion_work", work, "work of adhesion")
+        self.range = _positive("adhesion_range", range_, "range of adhesion")
+
+    @property
+    def peak_stress(self):
+        return self.work / self.range
+
+    def scaled(self, length, pressure):
+        return Exponential(self.work / (length * pressure), self.range / length)
+
+    def energy(self, gap):
+        return -self.work * np.exp(-gap / self.range)
+
+    def energy_change(self, gap, trial):
+        """``phi(trial) - phi(gap)`` node by node, in a form that does not cancel for close gaps."""
+        return self.energy(gap) * np.expm1((gap - trial) / self.range)
+
+    def force(self, gap, out=None):
+        out = np.divide(gap, -self.range, out=out)
+        np.exp(out, out=out)
+        out *= self.peak_stress
+        return out
+
+    def curvature(self, gap):
+        return -self.peak_stress / self.range * np.exp(-gap / self.range)
+
+    def describe(self):
+        return (f"exponential law: w = {self.work:.6g}, range rho = {self.range:.6g}, "
+                f"peak stress w/rho = {self.peak_stress:.6g}")
+
+
+def make_law(kind, work=None, stress=None, range_=None):
+    """The law ``kind`` ("none", "dugdale", "exponential") from its parameters (None for "none").
+
+    Dugdale takes ``stress`` (sigma0) or ``range_`` (h0, then sigma0 = w / h0); exponential takes ``range_``.
+    """
+    if kind == "none":
+        return None
+    if kind == "dugdale":
+        if stress is None and range_ is not None:
+            stress = work / _positive("adhesion_range", range_, "range of adhesion") if work else None
+        return Dugdale(work, stress)
+    if kind == "exponential":
+        return Exponential(work, range_)
+    raise ParameterError("adhesion", f"the adhesion law is one of {', '.join(LAWS)}, got '{kind}'")
+
+
+def tabor_parameter(law, radius, E_star):
+    """Tabor's parameter mu = (R w^2 / (E*^2 z0^3))^(1/3) with z0 the law's range (dimensionless).
+
+    Large mu: the JKR limit (short-range adhesion, compliant bodies); small mu: the DMT limit. For
+    the Dugdale law Maugis's lambda = sigma0 (9 R / (2 pi w E*^2))^(1/3) = (9 / (2 pi))^(1/3) mu
+    is the usual form (:func:`maugis_parameter`).
+    """
+    return (radius * law.work ** 2 / (E_star ** 2 * law.range ** 3)) ** (1.0 / 3.0)
+
+
+def maugis_parameter(law, radius, E_star):
+    """Maugis's lambda = sigma0 (9 R / (2 pi w E*^2))^(1/3) with sigma0 the law's peak stress."""
+    return law.peak_stress * (9.0 * radius / (2.0 * math.pi * law.work * E_star ** 2)) ** (1.0 / 3.0)

@@ -1,0 +1,195 @@
+"""Projected conjugate gradients on the gap for adhesive contact (:mod:`roughpetsc.adhesive`).
+
+The algorithm of Rey, Anciaux and Molinari (Comput. Mech. 60, 2017), Polonsky-Keer's CG with the gap
+as the unknown and the mean gap as the constraint, with three changes of ours:
+
+* the search direction is preconditioned by the compliance (the inverse symbol 1 / (pi E* |k|) of the
+  Hessian S, as Polonsky-Keer on the pressure is preconditioned by the stiffness; Vollebregt, J.
+  Comput. Phys. 257, 2014), restricted to the free set and kept at zero mean there;
+* the free set is the nodes out of contact and the contact nodes whose contact pressure is negative
+  (they open along the direction itself, as in Vollebregt's BCCG), with the Polak-Ribiere beta
+  clipped at 0 so conjugacy survives changes of the set;
+* the step minimises the quadratic model with the law's curvature phi'' when that model is convex and
+  the elastic one otherwise, and is then cut back until the energy decreases (Armijo), since phi makes
+  the energy non-convex: the iterates follow the energy downhill to the local minimum next to the
+  start, which is what a quasi-static path of adhesive contact needs.
+
+After each step the gap is projected onto {g >= 0, mean g = gbar} exactly (a shift of the positive
+nodes found by Newton's method on a piecewise-linear function). Every stop is decided on a freshly
+computed S g.
+"""
+
+import numpy as np
+
+from ..kkt import STAGNATION_ITERATIONS, History, allsum
+from .protocol import Outcome
+
+REFRESH = 50  # recompute S g at least every REFRESH iterations (the update S g -= step S t drifts)
+ARMIJO = 1e-4
+MAX_BACKTRACKS = 40
+
+
+def project_mean(mpi, g, target, n):
+    """``g <- max(g - c, 0)`` with c such that the mean of g is ``target`` (in place).
+
+    ``f(c) = sum max(g - c, 0) - n target`` is convex, decreasing and piecewise linear; Newton's method
+    from the uniform shift (where f >= 0) increases c monotonically to the root in a few steps.
+    """
+    total, = allsum(mpi, [g.sum()])
+    c = (total - n * target) / n
+    for _ in range(100):
+        above = g > c
+        count, excess = allsum(mpi, [np.count_nonzero(above), (g - c).sum(where=above)])
+        f = excess - n * target
+        if f <= 1e-15 * n * max(target, 1e-300) or not count:
+            break
+        c += f / count
+    g -= c
+    np.maximum(g, 0.0, out=g)
+
+
+def gap_cg(adhesive, target):
+    """Solve ``adhesive`` (an :class:`~roughpetsc.adhesive.AdhesiveContact`) at the scaled mean gap ``target``.
+
+    ``adhesive.gap`` holds the start and receives the solution; ``adhesive.elastic`` holds S (g + h) of
+    the last fresh evaluation. Returns an :class:`~roughpetsc.solvers.protocol.Outcome`.
+    """
+    problem = adhesive.problem
+    vecs = [problem.vec() for _ in range(4)]
+    try:
+        return _iterate(adhesive, target, *vecs)
+    finally:
+        for v in vecs:
+            v.destroy()
+
+
+def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, previous_vec):
+    problem = adhesive.problem
+    operator, mpi, n = problem.operator, problem.mpi, problem.n
+    law = adhesive.scaled_law
+    shape = operator.local_shape
+    g = problem.local(adhesive.gap).ravel()
+    elastic = problem.local(adhesive.elastic).ravel()
+    t = problem.local(direction_vec).ravel()
+    response = problem.local(response_vec).ravel()
+    z = problem.local(preconditioned_vec).ravel()
+    r_old = problem.local(previous_vec).ravel()
+    t[...] = 0.0
+    r_old[...] = 0.0
+    project_mean(mpi, g, target, n)
+    history = History(problem)
+    rz_old, fresh_needed, since_fresh = 1.0, True, 0
+    best, best_iteration, stopped_by = np.inf, 0, None
+    iteration, reason = 0, "DIVERGED_MAXITS"
+    while True:
+        if fresh_needed or since_fresh >= REFRESH:
+            adhesive.elastic_pressure(adhesive.gap, adhesive.elastic)
+            fresh_needed, since_fresh = False, 0
+        r, lam, kkt = adhesive.stationarity(g.reshape(shape), elastic.reshape(shape))
+        r = r.ravel()
+        if kkt.natural <= adhesive.rtol and since_fresh:
+            fresh_needed = True  # confirm on a freshly computed S g
+            continue
+        history.record(iteration, kkt.natural)
+        if kkt.natural <= adhesive.rtol:
+            reason = "CONVERGED_USER"
+            break
+        if kkt.natural < best:
+            best, best_iteration = kkt.natural, iteration
+        if iteration >= adhesive.max_iter:
+            break
+        if history.out_of_time(adhesive.max_seconds):
+            reason, stopped_by = "DIVERGED_USER", "time limit"
+            break
+        if iteration - best_iteration >= STAGNATION_ITERATIONS:
+            reason, stopped_by = "DIVERGED_USER", "stagnation"
+            break
+        free = ((g > 0) | (r < lam)).astype(np.float64)
+        count, = allsum(mpi, [free.sum()])
+        # The residual on the free set, at zero mean there (directions keep the mean gap).
+        np.subtract(r, lam, out=response)
+        response *= free
+        shift, = allsum(mpi, [response.sum()])
+        response -= shift / count * free
+        operator.displacement(response_vec, preconditioned_vec)
+        _restrict(mpi, z, free, count)
+        rz, r_old_z = allsum(mpi, [np.dot(response, z), np.dot(r_old, z)])
+        beta = max((rz - r_old_z) / rz_old, 0.0) if iteration else 0.0
+        np.copyto(r_old, response)
+        rz_old = rz
+        t *= beta
+        t += z
+        _restrict(mpi, t, free, count)
+        slope = _feasible(mpi, t, g, r)
+        if not slope > 0:
+            # Not a descent direction once feasible: the projected residual is one (CG restarts).
+            np.copyto(t, response)
+            slope = _feasible(mpi, t, g, r)
+            r_old[...] = 0.0
+            if not slope > 0:
+                reason, stopped_by = "DIVERGED_LS_FAILURE", "no feasible descent direction (round-off)"
+                break
+        operator.elastic_pressure(direction_vec, response_vec)  # S t
+        curvature_elastic, curvature_law = allsum(mpi, [np.dot(t, response), np.dot(law.curvature(g), t * t)])
+        curvature = curvature_elastic + curvature_law
+        if not curvature > 0:
+            curvature = curvature_elastic
+        step = _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, slope / curvature)
+        if step is None:
+            reason, stopped_by = "DIVERGED_LS_FAILURE", "no decrease of the energy along the direction"
+            break
+        g -= step * t
+        if allsum(mpi, [np.count_nonzero(g < 0)])[0]:
+            project_mean(mpi, g, target, n)
+            fresh_needed = True
+        else:
+            elastic -= step * response
+        since_fresh += 1
+        iteration += 1
+    notes = [stopped_by] if stopped_by else []
+    if not reason.startswith("CONVERGED") and np.isfinite(best):
+        notes.append(f"best natural residual {best:.2g}")
+    return Outcome(separation=target, iterations=iteration,
+                   reason=f"{reason} ({', '.join(notes)})" if notes else reason, history=history.as_array())
+
+
+def _restrict(mpi, v, free, count):
+    """``v`` restricted to the free set and shifted to zero mean there (in place)."""
+    v *= free
+    total, = allsum(mpi, [v.sum()])
+    v -= total / count * free
+
+
+def _feasible(mpi, t, g, r):
+    """Make ``-t`` a feasible direction at g = 0 (in place); returns the slope ``<r, t>`` of the energy.
+
+    A contact node (g = 0) may only open: where t > 0 it is set to 0, and the mean of t is restored on
+    the nodes out of contact (g > 0), which can move either way; small steps along -t then need no
+    projection, so the energy change of the line search is that of the projected iterate.
+    """
+    t[(g == 0) & (t > 0)] = 0.0
+    open_nodes = g > 0
+    count, total = allsum(mpi, [np.count_nonzero(open_nodes), t.sum()])
+    t[open_nodes] -= total / count
+    slope, = allsum(mpi, [np.dot(r, t)])
+    return slope
+
+
+def _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, step):
+    """The first of ``step``, step/2, ... along -t that decreases the energy enough (None if none does).
+
+    The test is on the energy along the line before the projection (phi continued below g = 0 by its
+    formula), whose slope at 0 is exactly ``slope``; the projection follows, as in Polonsky-Keer. The
+    change is summed from node-wise changes, so it does not cancel near the solution: the elastic part
+    is the quadratic -s <S(g + h), t> + s^2/2 <t, S t>, the law's part sum (phi(g - s t) - phi(g)).
+    """
+    law, mpi = adhesive.scaled_law, adhesive.problem.mpi
+    elastic_slope, = allsum(mpi, [np.dot(elastic, t)])
+    for _ in range(MAX_BACKTRACKS):
+        trial = g - step * t
+        law_change, = allsum(mpi, [law.energy_change(g, trial).sum()])
+        change = step * (0.5 * step * curvature_elastic - elastic_slope) + law_change
+        if change <= -ARMIJO * step * slope:
+            return step
+        step *= 0.5
+    return None

@@ -1,0 +1,179 @@
+"""Adhesive contact in the periodic BEM (roughpetsc.adhesive, roughpetsc.solvers.gap_cg) against closed forms.
+
+References: Derjaguin's approximation, exact for a paraboloid against a flat when the bodies are rigid
+(the force at closest gap D is 2 pi R (-phi(D)) for any law phi); the first-order conditions of
+the adhesive problem checked with numpy's FFT alone; the closed forms of roughpetsc.models where
+they apply.
+"""
+
+import contextlib
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import MPI_ENV, ROOT
+from roughpetsc.adhesive import AdhesiveContact, approach_retraction, dissipated_energy
+from roughpetsc.contact import ContactProblem
+from roughpetsc.errors import ParameterError
+from roughpetsc.interaction import Dugdale, Exponential, make_law
+from roughpetsc.surfaces import Grid, fractal
+
+RADIUS = 1.0
+
+
+def sphere(n, length=1.0):
+    x = (np.arange(n) - n / 2) * length / n
+    xx, yy = np.meshgrid(x, x, indexing="ij")
+    return Grid(n, n, length, length), -(xx ** 2 + yy ** 2) / (2 * RADIUS)
+
+
+@contextlib.contextmanager
+def adhesive_problem(grid, heights, E_star, law, rtol):
+    """An :class:`AdhesiveContact` on a periodic problem, destroyed with it afterwards."""
+    problem = ContactProblem(grid, heights, E_star, fft_effort="FFTW_ESTIMATE")
+    adhesive = AdhesiveContact(problem, law, rtol=rtol)
+    try:
+        yield adhesive
+    finally:
+        adhesive.destroy()
+        problem.destroy()
+
+
+def numpy_residuals(grid, heights, E_star, law, gbar, pbar, gap):
+    """Equilibrium out of contact and the sign of the contact pressure, from the gap with numpy alone.
+
+    u = g - gbar + h (zero mean), p = F^-1[pi E* |k| F[u]] + pbar. Out of contact p must be the law's
+    traction -phi'(g); in contact the contact pressure p + phi'(0) must be >= 0. Both relative to
+    sqrt(m0^p) of the surface.
+    """
+    h = heights - heights.mean()
+    k0 = np.fft.fftfreq(grid.n0, grid.l0 / grid.n0)
+    k1 = np.fft.fftfreq(grid.n1, grid.l1 / grid.n1)
+    k = np.hypot(*np.meshgrid(k0, k1, indexing="ij"))
+    u = gap - gbar + h
+    pressure = np.fft.ifft2(np.pi * E_star * k * np.fft.fft2(u)).real + pbar
+    scale = np.sqrt(np.mean(np.fft.ifft2(np.pi * E_star * k * np.fft.fft2(h)).real ** 2))
+    out = gap > 0
+    traction = -law.force(gap)
+    equilibrium = np.abs(pressure - traction)[out].max() / scale
+    contact_pressure = (pressure + law.force(np.zeros(1)))[~out]
+    worst_contact = contact_pressure.min() / scale if contact_pressure.size else 0.0
+    return equilibrium, worst_contact
+
+
+def test_rigid_sphere_meets_derjaguin():
+    """A stiff sphere out of contact: the force is 2 pi R w exp(-D / rho) (Derjaguin, exact for a paraboloid)."""
+    grid, heights = sphere(128)
+    work, range_ = 1e-3, 1e-3
+    top = (heights - heights.mean()).max()
+    with adhesive_problem(grid, heights, 1e7, Exponential(work, range_), 1e-10) as adhesive:
+        for closest in (3 * range_, range_, 0.2 * range_):
+            result = adhesive.solve(closest + top)
+            assert result.converged, result.reason
+            force = result.pbar * grid.area
+            derjaguin = -2 * math.pi * RADIUS * work * math.exp(-closest / range_)
+            assert force == pytest.approx(derjaguin, rel=1e-4)
+            assert result.A == 0
+
+
+@pytest.mark.parametrize("law", [Exponential(5e-5, 1e-3), Dugdale(5e-5, 5e-2)])
+def test_rough_adhesive_solution_meets_its_first_order_conditions(law):
+    """A rough surface in adhesive contact: the numpy check of equilibrium and of the contact pressure sign."""
+    grid = Grid(64, 64, 1.0, 1.0)
+    heights = fractal(grid, 2, 16, 0.8, 1e-2, seed=3)  # rms height 5.2e-3
+    E_star = 1.0
+    with adhesive_problem(grid, heights, E_star, law, 1e-10) as adhesive:
+        for gbar in (1e-2, 7e-3, 5e-3):
+            result = adhesive.solve(gbar)
+            assert result.converged, result.reason
+            pressure, gap = adhesive.fields(result.pbar)
+            assert gap.min() >= 0 and gap.mean() == pytest.approx(gbar, rel=1e-12)
+            assert pressure.mean() == pytest.approx(result.pbar, rel=1e-9, abs=1e-12)
+            equilibrium, worst_contact = numpy_residuals(grid, heights, E_star, law, gbar, result.pbar, gap)
+            assert equilibrium < 1e-9 and worst_contact > -1e-9
+            assert 0 < result.A < 1
+
+
+def test_approach_and_retraction_differ_and_dissipate():
+    """Under displacement control the sphere jumps into contact on approach and sticks on retraction."""
+    grid, heights = sphere(128)
+    work, stress = 1e-5, 2e-2
+    top = (heights - heights.mean()).max()
+    gbars = top + approach_retraction(2e-3, -2e-3, 20)
+    with adhesive_problem(grid, heights, 1.0, Dugdale(work, stress), 1e-9) as adhesive:
+        results = list(adhesive.path(gbars))
+    assert all(r.converged for r in results), [r.reason for r in results if not r.converged]
+    pbars = np.array([r.pbar for r in results])
+    areas = np.array([r.A for r in results])
+    approach, retraction = areas[:21], areas[20:][::-1]
+    # At equal mean gap the retracting contact is at least as large, and strictly larger somewhere.
+    assert np.all(retraction >= approach) and np.any(retraction > approach)
+    assert dissipated_energy(gbars, pbars) > 0
+
+
+def test_bad_parameters_name_the_option():
+    grid, heights = sphere(16)
+    for make, parameter in ((lambda: Dugdale(-1.0, 1.0), "adhesion_work"),
+                            (lambda: Exponential(1.0, 0.0), "adhesion_range"),
+                            (lambda: make_law("lennard-jones", 1.0, 1.0), "adhesion")):
+        with pytest.raises(ParameterError) as error:
+            make()
+        assert error.value.parameter == parameter
+    problem = ContactProblem(grid, heights, 1.0, fft_effort="FFTW_ESTIMATE", boundary="free")
+    try:
+        with pytest.raises(ParameterError, match="periodic"):
+            AdhesiveContact(problem, Exponential(1e-3, 1e-3))
+    finally:
+        problem.destroy()
+
+
+RANKS_SCRIPT = """
+import sys
+import numpy as np
+import petsc4py
+petsc4py.init()
+from petsc4py import PETSc
+from roughpetsc.adhesive import AdhesiveContact
+from roughpetsc.contact import ContactProblem
+from roughpetsc.interaction import Exponential
+from roughpetsc.surfaces import Grid, fractal
+grid = Grid(45, 32, 1.0, 1.0)
+heights = fractal(grid, 2, 10, 0.8, 1e-2, seed=5)
+problem = ContactProblem(grid, heights, 1.0, fft_effort="FFTW_ESTIMATE")
+adhesive = AdhesiveContact(problem, Exponential(5e-5, 1e-3), rtol=1e-11)
+rows = []
+for gbar in (1e-2, 6e-3):
+    result = adhesive.solve(gbar)
+    assert result.converged, result.reason
+    pressure, gap = adhesive.fields(result.pbar)
+    rows.append((result.pbar, result.A, np.concatenate(problem.mpi.allgather(pressure))))
+if problem.mpi.Get_rank() == 0:
+    np.savez(sys.argv[1], pbar=[r[0] for r in rows], A=[r[1] for r in rows], pressure=[r[2] for r in rows])
+adhesive.destroy()
+problem.destroy()
+"""
+
+
+def test_two_and_three_ranks_equal_one_rank(tmp_path):
+    script = tmp_path / "ranks.py"
+    script.write_text(RANKS_SCRIPT)
+    env = dict(os.environ, **MPI_ENV)
+    env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
+    answers = []
+    for ranks in (1, 2, 3):
+        out = tmp_path / f"r{ranks}.npz"
+        command = [sys.executable, str(script), str(out)]
+        if ranks > 1:
+            command = ["mpiexec", "-n", str(ranks), "--oversubscribe", *command]
+        run = subprocess.run(command, capture_output=True, text=True, env=env, timeout=300)
+        assert run.returncode == 0, run.stdout + run.stderr
+        answers.append(np.load(out))
+    for other in answers[1:]:
+        assert np.array_equal(other["A"], answers[0]["A"])
+        assert np.allclose(other["pbar"], answers[0]["pbar"], rtol=1e-9, atol=0)
+        scale = np.abs(answers[0]["pressure"]).max()
+        assert np.abs(other["pressure"] - answers[0]["pressure"]).max() < 1e-9 * scale
