@@ -73,6 +73,7 @@ class AdhesiveContact:
         self.elastic = problem.vec()  # S g + p_c = S (g + h)
         self.pressure_scale = math.sqrt(problem.m0p_scaled)
         self.started = False
+        self.last_pbar = 0.0
         self.name = "gapcg"
 
     def destroy(self):
@@ -112,12 +113,17 @@ class AdhesiveContact:
         return float(sums.sum() / self.problem.n)
 
     # --- solves ---------------------------------------------------------------
-    def solve(self, gbar):
+    def solve(self, gbar=None, pbar=None, pstar=None):
         """Solve at the mean gap ``gbar`` (length units) from the last solution; a :class:`Result`.
 
         The first solve starts from the rigid gap max(gbar - h, 0) shifted to mean gbar; later ones from
-        the previous gap shifted by the change of gbar (both projected onto g >= 0, mean gbar).
+        the previous gap shifted by the change of gbar (both projected onto g >= 0, mean gbar). A load
+        (``pbar``, ``pstar``) is refused: adhesive contact is solved under displacement control.
         """
+        if gbar is None:
+            raise ParameterError("pbar" if pstar is None else "pstar",
+                                 "adhesive contact is solved under displacement control: prescribe the mean "
+                                 "gap (the load jumps where contact snaps in or out)")
         if not (gbar > 0 and math.isfinite(gbar)):
             raise ParameterError("gbar", f"the mean gap must be positive and finite, got {gbar}")
         problem = self.problem
@@ -147,6 +153,7 @@ class AdhesiveContact:
         in_contact = (g == 0).astype(np.float64)
         measures = measure(problem, in_contact, g)
         pbar = -lam * problem.pressure_scale
+        self.last_pbar = pbar
         gbar = target * problem.height_scale
         return Result(
             pbar=pbar, pstar=pbar / problem.sqrt_m0p, A=measures["A"], A_corrected=measures["A_corrected"],
@@ -155,20 +162,28 @@ class AdhesiveContact:
             time_s=time.perf_counter() - start, reason=reason, converged=converged, solver=self.name,
             control="displacement", history=outcome.history)
 
-    def fields(self, pbar):
-        """This rank's rows of the total pressure (compressive positive) and the gap, physical units.
+    def fields(self):
+        """This rank's rows of the total pressure (compressive positive) and the gap of the last solve.
 
-        ``pbar`` is the mean pressure of the last result (pressure units). The pressure is
-        S (g + h) + pbar: the contact pressure in contact, the law's traction -phi'(g) out of it.
+        Pressure and length units. The pressure is S (g + h) + pbar: the contact pressure in contact,
+        the law's traction -phi'(g) out of it.
         """
         problem = self.problem
-        pressure = problem.local(self.elastic, readonly=True) * problem.pressure_scale + pbar
+        pressure = problem.local(self.elastic, readonly=True) * problem.pressure_scale + self.last_pbar
         return pressure, problem.local(self.gap, readonly=True) * problem.height_scale
 
     def path(self, gbars):
         """A generator of Results along the mean gaps ``gbars`` (length units), each warm-started."""
         for gbar in gbars:
             yield self.solve(gbar)
+
+
+def summit_radius(m4h):
+    """1 / (mean summit curvature (8/3) sqrt(m4^h / pi)) (Nayak's high-bandwidth limit), length units.
+
+    The radius with which the header's Tabor parameter describes a rough surface.
+    """
+    return 1.0 / (8.0 / 3.0 * math.sqrt(m4h / math.pi))
 
 
 def approach_retraction(gbar_max, gbar_min, steps):

@@ -86,8 +86,13 @@ class Exponential:
         return -self.work * np.exp(-gap / self.range)
 
     def energy_change(self, gap, trial):
-        """``phi(trial) - phi(gap)`` node by node, in a form that does not cancel for close gaps."""
-        return self.energy(gap) * np.expm1((gap - trial) / self.range)
+        """``phi(trial) - phi(gap)`` node by node, in a form that does not cancel for close gaps.
+
+        Below g = 0 (a line search's trial before its projection) phi is continued by its tangent at 0,
+        as the Dugdale law continues itself, so that a long step cannot gain unbounded energy.
+        """
+        above = np.maximum(trial, 0.0)
+        return self.energy(gap) * np.expm1((gap - above) / self.range) + self.peak_stress * (trial - above)
 
     def force(self, gap, out=None):
         out = np.divide(gap, -self.range, out=out)

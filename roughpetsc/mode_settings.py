@@ -37,7 +37,8 @@ PARAMETER_OPTIONS = {**{keyword: option for option, keyword in surfaces.FRACTAL_
                      "amplitude": "surface_amplitude", "wavelength": "surface_wavelength", "radius": "surface_radius",
                      "effort": "fft_effort", "E_star": "E_star", "e_star": "E_star", "rtol": "kkt_rtol",
                      "tao_type": "tao_type", "pstar": "pstar", "pbar": "pbar", "gbar": "gbar",
-                     "boundary": "boundary", "hardness": "hardness", "depths": "stress_depths", "nu": "nu"}
+                     "boundary": "boundary", "hardness": "hardness", "depths": "stress_depths", "nu": "nu",
+                     **{name: name for name in ("adhesion", "adhesion_work", "adhesion_stress", "adhesion_range")}}
 
 
 def user_message(error):

@@ -13,6 +13,7 @@ import sys
 
 import numpy as np
 
+from . import adhesive_options
 from .errors import UserError
 from .mode_settings import GENERAL_OPTIONS, check_fft, check_modulus, check_rtol, options_named, read_table
 
@@ -48,7 +49,7 @@ PHYSICS_OPTIONS = [
                           "Mises stress and its maximum are computed for the last step and written to -output "
                           "(/stresses; nothing is computed without this option)"),
     ("nu", 0.3, "Poisson's ratio of the body, for -stress_depths"),
-]
+] + adhesive_options.OPTIONS
 
 LOAD_OPTIONS = [
     ("pstar", 0.5, "load control: p* = pbar / sqrt(m0^p) (the default load)"),
@@ -56,6 +57,8 @@ LOAD_OPTIONS = [
     ("gbar", "", "displacement control: prescribed mean gap (rigid separation) d, length units"),
     ("pstar_list", "", "load control: comma-separated p* values solved in order with warm starts, or 'history' "
                        "(the 95 steps of (7.11), D1 = 0.2/30)"),
+    ("gbar_list", "", "displacement control: comma-separated mean gaps solved in order with warm starts (an "
+                      "approach and retraction with -adhesion)"),
 ]
 
 # Read by the solvers from the options database (roughpetsc.solvers).
@@ -110,6 +113,7 @@ class SolveSettings:
     hardness: float = None
     stress_depths: tuple = ()
     nu: float = 0.3
+    adhesion: object = None
 
     @property
     def control(self):
@@ -124,9 +128,12 @@ class SolveSettings:
 
 def load_steps(reader):
     """The list of loads: ``("pstar" | "pbar" | "gbar", value)`` in the order to solve."""
-    given = [name for name in ("pstar", "pbar", "gbar", "pstar_list") if reader.has(name)]
+    given = [name for name in ("pstar", "pbar", "gbar", "pstar_list", "gbar_list") if reader.has(name)]
     if len(given) > 1:
-        raise UserError("give only one of -pstar, -pbar, -gbar, -pstar_list; got " + ", ".join("-" + g for g in given))
+        raise UserError("give only one of -pstar, -pbar, -gbar, -pstar_list, -gbar_list; got "
+                        + ", ".join("-" + g for g in given))
+    if given == ["gbar_list"]:
+        return [("gbar", v) for v in reader.reals("gbar_list")], "gbar_list"
     if given == ["pstar_list"]:
         if reader.string("pstar_list", "").strip().lower() == "history":
             from . import loads
@@ -162,6 +169,8 @@ def read_settings(reader, general_options=GENERAL_OPTIONS):
     if settings.resume and not settings.output:
         raise UserError("-resume needs -output: the file of the run to continue")
     check_fft(settings.fft_threads, settings.fft_effort)
+    if settings.adhesion is not None:
+        adhesive_options.check(settings)
     return settings
 
 
@@ -182,7 +191,7 @@ def read_physics(reader):
             check_depths(depths)
         check_poisson(values["nu"])
     return {"boundary": values["boundary"], "hardness": hardness or None, "stress_depths": depths,
-            "nu": values["nu"]}
+            "nu": values["nu"], "adhesion": adhesive_options.read_law(values)}
 
 
 def check_files(settings, comm):
@@ -211,7 +220,6 @@ def run(reader, comm):
 
     from . import fftw, io, store, surfaces
     from .contact import ContactProblem
-    from .solvers import Solver
     from .kkt import Progress
     from .options import check_unused
     from .results import PathRecord
@@ -231,7 +239,7 @@ def run(reader, comm):
         problem = ContactProblem(grid, heights, settings.E_star, PETSc.COMM_WORLD, settings.fft_threads, effort,
                                  boundary=settings.boundary, hardness=settings.hardness)
     statistics = surface_moments(grid, heights, settings.E_star)
-    solver = Solver(problem, settings.control, settings.tao_type, settings.kkt_rtol)
+    solver = make_solver(settings, problem)
     rank0 = comm.Get_rank() == 0
     if settings.progress_interval > 0 and rank0 and not settings.quiet and sys.stdout.isatty():
         problem.progress = Progress(settings.progress_interval, sys.stdout)
@@ -244,6 +252,7 @@ def run(reader, comm):
                    "sqrt_m0h": problem.sqrt_m0h, "sqrt_m0p": problem.sqrt_m0p,
                    "solver": solver.name, "control": settings.control, "kkt_rtol": settings.kkt_rtol,
                    "boundary": settings.boundary, "hardness": settings.hardness or 0.0,
+                   "adhesion": adhesive_options.summary(settings.adhesion, statistics, settings.E_star),
                    "ranks": comm.Get_size(), **io.provenance()}
         # Fields written by every rank into its rows where h5py is the parallel build (store.write_distributed).
         distributed = bool(settings.output) and settings.output_fields != "none" and store.parallel_hdf5(comm)
@@ -260,6 +269,8 @@ def run(reader, comm):
             f"solver {solver.name}, E*={settings.E_star:g}, sqrt(m0h)={problem.sqrt_m0h:.4g}, "
             f"sqrt(m0p)={problem.sqrt_m0p:.4g}, alpha_h={statistics['alpha_h']:.4g}, "
             f"alpha_p={statistics['alpha_p']:.4g}")
+        if settings.adhesion is not None:
+            say(adhesive_options.header(settings.adhesion, summary["adhesion"]))
         say(f"{'p*':>10} {'A*':>10} {'A*corr':>10} {'g*':>11} {'KKT nat':>9} {'its':>6} {'Kapps':>6} "
             f"{'time s':>8}  reason")
         for step in record.steps:
@@ -286,6 +297,15 @@ def run(reader, comm):
         signal.signal(signal.SIGTERM, previous_sigterm)
         solver.destroy()
         problem.destroy()
+
+
+def make_solver(settings, problem):
+    """The Solver of ``-tao_type``, or the adhesive gap solver under ``-adhesion``."""
+    if settings.adhesion is not None:
+        return adhesive_options.make_solver(settings, problem)
+    from .solvers import Solver
+
+    return Solver(problem, settings.control, settings.tao_type, settings.kkt_rtol)
 
 
 def whole_last_fields(record, comm, distributed, settings):

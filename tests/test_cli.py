@@ -102,6 +102,13 @@ BAD_INPUTS = [
     (lambda t: ["-pk_pc", "jacobi"], 1, "-pk_pc"),
     (lambda t: ["-tao_type", "bnls", "-bound_pc", "ilu"], 1, "-bound_pc"),
     (lambda t: ["-solve_max_time", -1], 1, "-solve_max_time"),
+    (lambda t: ["-adhesion", "dugdale", "-adhesion_stress", 0.1, "-gbar", 1e-4], 1, "-adhesion_work"),
+    (lambda t: ["-adhesion", "morse", "-gbar", 1e-4], 1, "-adhesion"),
+    (lambda t: ["-adhesion", "exponential", "-adhesion_work", 1e-7, "-gbar", 1e-4], 1, "-adhesion_range"),
+    (lambda t: ["-adhesion", "exponential", "-adhesion_work", 1e-7, "-adhesion_range", 1e-5, "-pstar", 0.5], 1,
+     "-pstar"),
+    (lambda t: ["-adhesion", "exponential", "-adhesion_work", 1e-7, "-adhesion_range", 1e-5, "-gbar", 1e-4,
+                "-boundary", "free"], 1, "-boundary"),
 ]
 
 

@@ -1,0 +1,69 @@
+"""The command line of adhesive contact (``-adhesion`` in ``-mode solve``): its options, checks and header.
+
+The physics is :mod:`roughpetsc.interaction` (the laws) and :mod:`roughpetsc.adhesive` (the problem and
+its solver); this module only turns options into them and refuses what cannot be combined yet.
+"""
+
+from .errors import UserError
+from .mode_settings import options_named
+
+OPTIONS = [
+    ("adhesion", "none", "adhesive law: none | dugdale (tension -adhesion_stress up to the range w / sigma0) | "
+                         "exponential (phi = -w exp(-g / rho), rho = -adhesion_range); periodic cell, displacement "
+                         "control (-gbar, -gbar_list), solved for the gap by projected CG"),
+    ("adhesion_work", 0.0, "work of adhesion w, pressure x length units"),
+    ("adhesion_stress", 0.0, "Dugdale stress sigma0, pressure units (or -adhesion_range h0, then sigma0 = w / h0)"),
+    ("adhesion_range", 0.0, "range of the law, length units: rho (exponential) or h0 (dugdale)"),
+]
+
+
+def read_law(values):
+    """The law of ``-adhesion`` from the option values (None for none); a missing parameter is refused by name."""
+    from .interaction import make_law
+
+    with options_named():
+        return make_law(values["adhesion"], values["adhesion_work"] or None, values["adhesion_stress"] or None,
+                        values["adhesion_range"] or None)
+
+
+def check(settings):
+    """Refuse, by option name, what adhesion cannot be combined with yet."""
+    if settings.control != "displacement":
+        raise UserError(f"-{settings.load_option}: adhesive contact is solved under displacement control (it jumps "
+                        "in and out of contact under load control); prescribe -gbar or -gbar_list")
+    for refused, given in (("tao_type", settings.tao_type), ("resume", settings.resume),
+                           ("hardness", settings.hardness), ("stress_depths", settings.stress_depths)):
+        if given:
+            raise UserError(f"-{refused} cannot be combined with -adhesion yet (the adhesive problem is solved by "
+                            "its own projected CG on the gap)")
+    if settings.boundary != "periodic":
+        raise UserError("-boundary: adhesion is solved on the periodic cell only")
+
+
+def make_solver(settings, problem):
+    """The adhesive gap solver of the settings (the Solver facade's interface: solve, fields, name, destroy)."""
+    from .adhesive import AdhesiveContact
+    from .solvers.tao_options import max_seconds
+
+    return AdhesiveContact(problem, settings.adhesion, settings.kkt_rtol, max_seconds=max_seconds(None))
+
+
+def summary(law, statistics, E_star):
+    """The law, its parameters and Tabor's parameter for a run's summary (``{"law": "none"}`` without one).
+
+    The radius of Tabor's parameter is the mean summit radius of :func:`roughpetsc.adhesive.summit_radius`.
+    """
+    from .adhesive import summit_radius
+    from .interaction import tabor_parameter
+
+    if law is None:
+        return {"law": "none"}
+    radius = summit_radius(statistics["m4h"])
+    return {"law": law.name, "work": law.work, "range": law.range, "peak_stress": law.peak_stress,
+            "summit_radius": radius, "tabor": tabor_parameter(law, radius, E_star)}
+
+
+def header(law, summary):
+    """The header line of an adhesive run."""
+    return (f"  {law.describe()}; Tabor parameter mu = {summary['tabor']:.4g} "
+            f"(summit radius {summary['summit_radius']:.4g})")
