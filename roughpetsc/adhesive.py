@@ -86,23 +86,44 @@ class AdhesiveContact:
         self.problem.operator.elastic_pressure(gap_vec, out)
         out.axpy(1.0, self.problem.pressure_surface)
 
+    def gradient(self, g, elastic, out):
+        """``out = r = S (g + h) + phi'(g)`` of local arrays ``g`` and ``elastic`` = S (g + h)."""
+        self.scaled_law.force(g, out=out)
+        out += elastic
+
+    def multiplier(self, g, r, open_nodes):
+        """lambda, the mean of r out of contact; ``open_nodes`` (bool, written) marks g > 0. Also their count."""
+        np.greater(g, 0.0, out=open_nodes)
+        count, r_sum = allsum(self.problem.mpi, [np.count_nonzero(open_nodes), r.sum(where=open_nodes)])
+        return (r_sum / count if count else 0.0), count
+
+    def natural(self, g, r, lam, work):
+        """The natural residual max |min(g, (r - lambda) / sqrt(m0^p))| (scaled gaps); ``work`` is scratch."""
+        np.subtract(r, lam, out=work)
+        work *= 1.0 / self.pressure_scale
+        np.minimum(work, g, out=work)
+        np.abs(work, out=work)
+        return float(-allmin(self.problem.mpi, [-np.max(work, initial=0.0)])[0])
+
     def stationarity(self, g, elastic):
-        """``(r, lambda, natural, report)`` of local arrays ``g`` and ``elastic`` = S (g + h) (module docstring)."""
+        """``(r, lambda, report)`` of local arrays ``g`` and ``elastic`` = S (g + h) (module docstring).
+
+        The report: ``natural`` as above, ``min_p`` the least contact pressure r - lambda in contact and
+        ``complementarity`` the mean of g |r - lambda| out of contact (both over sqrt(m0^p)), ``min_g``.
+        """
         mpi = self.problem.mpi
-        r = elastic + self.scaled_law.force(g)
-        out_of_contact = g > 0
-        count, r_sum = allsum(mpi, [np.count_nonzero(out_of_contact), r.sum(where=out_of_contact)])
-        lam = r_sum / count if count else 0.0
-        scale = self.pressure_scale
-        excess = (r - lam) / scale
-        natural_local = np.max(np.abs(np.minimum(g, excess)), initial=0.0)
-        in_contact = ~out_of_contact
-        min_c = np.min(excess, where=in_contact, initial=np.inf)
+        r = np.empty_like(g)
+        self.gradient(g, elastic, r)
+        out_of_contact = np.empty(g.shape, dtype=bool)
+        lam, _ = self.multiplier(g, r, out_of_contact)
+        natural = self.natural(g, r, lam, np.empty_like(g))
+        excess = (r - lam) / self.pressure_scale
+        min_c = np.min(excess, where=~out_of_contact, initial=np.inf)
         equilibrium = np.abs(excess, where=out_of_contact, out=np.zeros_like(excess))
-        natural, neg_min_c, neg_min_g = -allmin(mpi, [-natural_local, min_c, g.min()]) * [1, -1, -1]
+        min_c, min_g = allmin(mpi, [min_c, g.min()])
         complementarity, = allsum(mpi, [np.dot(equilibrium.ravel(), g.ravel())])
-        kkt = KKTReport(natural=float(natural), complementarity=float(complementarity / self.problem.n),
-                        min_p=float(neg_min_c) if np.isfinite(neg_min_c) else 0.0, min_g=float(neg_min_g))
+        kkt = KKTReport(natural=natural, complementarity=float(complementarity / self.problem.n),
+                        min_p=float(min_c) if np.isfinite(min_c) else 0.0, min_g=float(min_g))
         return r, lam, kkt
 
     def energy(self, g, elastic):

@@ -35,6 +35,7 @@ class Dugdale:
     """The Maugis-Dugdale law: tensile stress ``stress`` (pressure units) up to the range w / stress."""
 
     name = "dugdale"
+    curved = False  # phi'' = 0 wherever it exists
 
     def __init__(self, work, stress):
         self.work = _positive("adhesion_work", work, "work of adhesion")
@@ -70,6 +71,7 @@ class Exponential:
     """``phi = -w exp(-g / rho)``: work ``work``, range ``range_`` (length units), peak stress w / rho."""
 
     name = "exponential"
+    curved = True
 
     def __init__(self, work, range_):
         self.work = _positive("adhesion_work", work, "work of adhesion")

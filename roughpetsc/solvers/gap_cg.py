@@ -63,17 +63,29 @@ def gap_cg(adhesive, target):
             v.destroy()
 
 
+class _Scratch:
+    """The local arrays of one solve, allocated once: the loop makes no N^2 temporaries."""
+
+    def __init__(self, size):
+        self.r = np.empty(size)
+        self.work = np.empty(size)
+        self.free = np.empty(size)
+        self.open = np.empty(size, dtype=bool)
+        self.mask = np.empty(size, dtype=bool)
+
+
 def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, previous_vec):
     problem = adhesive.problem
     operator, mpi, n = problem.operator, problem.mpi, problem.n
     law = adhesive.scaled_law
-    shape = operator.local_shape
     g = problem.local(adhesive.gap).ravel()
     elastic = problem.local(adhesive.elastic).ravel()
     t = problem.local(direction_vec).ravel()
     response = problem.local(response_vec).ravel()
     z = problem.local(preconditioned_vec).ravel()
     r_old = problem.local(previous_vec).ravel()
+    scratch = _Scratch(g.size)
+    r, work, free = scratch.r, scratch.work, scratch.free
     t[...] = 0.0
     r_old[...] = 0.0
     project_mean(mpi, g, target, n)
@@ -85,17 +97,18 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
         if fresh_needed or since_fresh >= REFRESH:
             adhesive.elastic_pressure(adhesive.gap, adhesive.elastic)
             fresh_needed, since_fresh = False, 0
-        r, lam, kkt = adhesive.stationarity(g.reshape(shape), elastic.reshape(shape))
-        r = r.ravel()
-        if kkt.natural <= adhesive.rtol and since_fresh:
+        adhesive.gradient(g, elastic, r)
+        lam, open_count = adhesive.multiplier(g, r, scratch.open)
+        natural = adhesive.natural(g, r, lam, work)
+        if natural <= adhesive.rtol and since_fresh:
             fresh_needed = True  # confirm on a freshly computed S g
             continue
-        history.record(iteration, kkt.natural)
-        if kkt.natural <= adhesive.rtol:
+        history.record(iteration, natural)
+        if natural <= adhesive.rtol:
             reason = "CONVERGED_USER"
             break
-        if kkt.natural < best:
-            best, best_iteration = kkt.natural, iteration
+        if natural < best:
+            best, best_iteration = natural, iteration
         if iteration >= adhesive.max_iter:
             break
         if history.out_of_time(adhesive.max_seconds):
@@ -104,46 +117,49 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
         if iteration - best_iteration >= STAGNATION_ITERATIONS:
             reason, stopped_by = "DIVERGED_USER", "stagnation"
             break
-        free = ((g > 0) | (r < lam)).astype(np.float64)
-        count, = allsum(mpi, [free.sum()])
+        # The free set: out of contact, and the contact nodes that pull (they open along the direction).
+        np.less(r, lam, out=scratch.mask)
+        scratch.mask |= scratch.open
+        np.copyto(free, scratch.mask)
+        count, = allsum(mpi, [np.count_nonzero(scratch.mask)])
         # The residual on the free set, at zero mean there (directions keep the mean gap).
         np.subtract(r, lam, out=response)
-        response *= free
-        shift, = allsum(mpi, [response.sum()])
-        response -= shift / count * free
+        _restrict(mpi, response, free, count, work)
         operator.displacement(response_vec, preconditioned_vec)
-        _restrict(mpi, z, free, count)
+        _restrict(mpi, z, free, count, work)
         rz, r_old_z = allsum(mpi, [np.dot(response, z), np.dot(r_old, z)])
         beta = max((rz - r_old_z) / rz_old, 0.0) if iteration else 0.0
         np.copyto(r_old, response)
         rz_old = rz
         t *= beta
         t += z
-        _restrict(mpi, t, free, count)
-        slope = _feasible(mpi, t, g, r)
+        _restrict(mpi, t, free, count, work)
+        slope = _feasible(mpi, t, g, r, scratch, open_count)
         if not slope > 0:
             # Not a descent direction once feasible: the projected residual is one (CG restarts).
             np.copyto(t, response)
-            slope = _feasible(mpi, t, g, r)
+            slope = _feasible(mpi, t, g, r, scratch, open_count)
             r_old[...] = 0.0
             if not slope > 0:
                 reason, stopped_by = "DIVERGED_LS_FAILURE", "no feasible descent direction (round-off)"
                 break
         operator.elastic_pressure(direction_vec, response_vec)  # S t
-        curvature_elastic, curvature_law = allsum(mpi, [np.dot(t, response), np.dot(law.curvature(g), t * t)])
-        curvature = curvature_elastic + curvature_law
+        curvature_elastic, = allsum(mpi, [np.dot(t, response)])
+        curvature = curvature_elastic + _law_curvature(law, mpi, g, t, work)
         if not curvature > 0:
             curvature = curvature_elastic
-        step = _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, slope / curvature)
+        step = _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, slope / curvature, work)
         if step is None:
             reason, stopped_by = "DIVERGED_LS_FAILURE", "no decrease of the energy along the direction"
             break
-        g -= step * t
-        if allsum(mpi, [np.count_nonzero(g < 0)])[0]:
+        np.multiply(t, step, out=work)
+        g -= work
+        if allsum(mpi, [np.count_nonzero(np.less(g, 0.0, out=scratch.mask))])[0]:
             project_mean(mpi, g, target, n)
             fresh_needed = True
         else:
-            elastic -= step * response
+            np.multiply(response, step, out=work)
+            elastic -= work
         since_fresh += 1
         iteration += 1
     notes = [stopped_by] if stopped_by else []
@@ -153,29 +169,41 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
                    reason=f"{reason} ({', '.join(notes)})" if notes else reason, history=history.as_array())
 
 
-def _restrict(mpi, v, free, count):
-    """``v`` restricted to the free set and shifted to zero mean there (in place)."""
+def _restrict(mpi, v, free, count, work):
+    """``v`` restricted to the free set and shifted to zero mean there (in place; ``work`` is scratch)."""
     v *= free
     total, = allsum(mpi, [v.sum()])
-    v -= total / count * free
+    np.multiply(free, total / count, out=work)
+    v -= work
 
 
-def _feasible(mpi, t, g, r):
+def _law_curvature(law, mpi, g, t, work):
+    """``<phi''(g), t^2>``: the law's part of the curvature along t (0 for a piecewise-linear law)."""
+    if not law.curved:
+        return 0.0
+    np.multiply(law.curvature(g), t, out=work)
+    total, = allsum(mpi, [np.dot(work, t)])
+    return total
+
+
+def _feasible(mpi, t, g, r, scratch, open_count):
     """Make ``-t`` a feasible direction at g = 0 (in place); returns the slope ``<r, t>`` of the energy.
 
     A contact node (g = 0) may only open: where t > 0 it is set to 0, and the mean of t is restored on
-    the nodes out of contact (g > 0), which can move either way; small steps along -t then need no
-    projection, so the energy change of the line search is that of the projected iterate.
+    the ``open_count`` nodes out of contact (``scratch.open``, g > 0), which can move either way; small
+    steps along -t then need no projection, so the energy change of the line search is that of the
+    projected iterate.
     """
-    t[(g == 0) & (t > 0)] = 0.0
-    open_nodes = g > 0
-    count, total = allsum(mpi, [np.count_nonzero(open_nodes), t.sum()])
-    t[open_nodes] -= total / count
+    np.greater(t, 0.0, out=scratch.mask)
+    np.logical_and(scratch.mask, ~scratch.open, out=scratch.mask)
+    np.copyto(t, 0.0, where=scratch.mask)
+    total, = allsum(mpi, [t.sum()])
+    np.subtract(t, total / open_count, out=t, where=scratch.open)
     slope, = allsum(mpi, [np.dot(r, t)])
     return slope
 
 
-def _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, step):
+def _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, step, trial):
     """The first of ``step``, step/2, ... along -t that decreases the energy enough (None if none does).
 
     The test is on the energy along the line before the projection (phi continued below g = 0 by its
@@ -186,7 +214,8 @@ def _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, step):
     law, mpi = adhesive.scaled_law, adhesive.problem.mpi
     elastic_slope, = allsum(mpi, [np.dot(elastic, t)])
     for _ in range(MAX_BACKTRACKS):
-        trial = g - step * t
+        np.multiply(t, -step, out=trial)
+        trial += g
         law_change, = allsum(mpi, [law.energy_change(g, trial).sum()])
         change = step * (0.5 * step * curvature_elastic - elastic_slope) + law_change
         if change <= -ARMIJO * step * slope:
