@@ -21,7 +21,9 @@ pressure, compressive positive):
 The natural residual certified after every solve is ``max |min(g / sqrt(m0^h), (r - lambda) /
 sqrt(m0^p))|`` over all nodes, on a gap whose S g is computed afresh, with lambda the mean of r out of
 contact (the best multiplier for those nodes). Its pressure scale sqrt(m0^p) (2.52) is that of the
-non-adhesive problem (the mean pressure may be zero or tensile here).
+non-adhesive problem (the mean pressure may be zero or tensile here). The report's ``load_error`` is
+the error of the prescribed quantity, the mean gap, over sqrt(m0^h); a converged solve has both below
+the tolerance.
 
 Only the periodic boundary is supported (the free boundary's stiffness is not a Fourier filter).
 """
@@ -35,6 +37,8 @@ from .contact import Result, measure
 from .errors import ParameterError
 from .kkt import KKTReport, allsum, allmin
 from .solvers.gap_cg import gap_cg
+
+SOLVERS = ("gapcg", "almm")
 
 
 class AdhesiveContact:
@@ -51,6 +55,11 @@ class AdhesiveContact:
     max_iter : int
     max_seconds : float
         Seconds after which a solve stops, reported as a time limit (0: none).
+    solver : "gapcg" or "almm"
+        The projected CG on the gap (:mod:`roughpetsc.solvers.gap_cg`) or TAO ALMM with the mean-gap
+        equality (:mod:`roughpetsc.solvers.adhesive_almm`, its TAO options under ``prefix``).
+    prefix : str or None
+        Options prefix of the TAO object of ``almm``.
 
     Attributes
     ----------
@@ -58,7 +67,7 @@ class AdhesiveContact:
         The scaled gap of the last solve, the start of the next.
     """
 
-    def __init__(self, problem, law, rtol=1e-8, max_iter=20000, max_seconds=0.0):
+    def __init__(self, problem, law, rtol=1e-8, max_iter=20000, max_seconds=0.0, solver="gapcg", prefix=None):
         if problem.boundary != "periodic":
             raise ParameterError("boundary", "adhesion is solved on the periodic cell only")
         if problem.upper_bound is not None:
@@ -74,9 +83,19 @@ class AdhesiveContact:
         self.pressure_scale = math.sqrt(problem.m0p_scaled)
         self.started = False
         self.last_pbar = 0.0
-        self.name = "gapcg"
+        if solver not in SOLVERS:
+            raise ParameterError("tao_type", f"the adhesive problem is solved by {' or '.join(SOLVERS)}, got "
+                                             f"'{solver}'")
+        self.name = solver
+        self.tao_solver = None
+        if solver == "almm":
+            from .solvers.adhesive_almm import AdhesiveALMM
+
+            self.tao_solver = AdhesiveALMM(self, prefix)
 
     def destroy(self):
+        if self.tao_solver is not None:
+            self.tao_solver.destroy()
         self.gap.destroy()
         self.elastic.destroy()
 
@@ -158,7 +177,7 @@ class AdhesiveContact:
             g += target - current / problem.n
         start = time.perf_counter()
         applications = problem.operator.applications
-        outcome = gap_cg(self, target)
+        outcome = gap_cg(self, target) if self.tao_solver is None else self.tao_solver.solve(target)
         return self._result(outcome, target, start, applications)
 
     def _result(self, outcome, target, start, applications):
@@ -167,10 +186,13 @@ class AdhesiveContact:
         g = problem.local(self.gap, readonly=True)
         elastic = problem.local(self.elastic, readonly=True)
         _, lam, kkt = self.stationarity(g, elastic)
-        converged = kkt.natural <= self.rtol
+        total, = allsum(problem.mpi, [g.sum()])
+        kkt.load_error = abs(total / problem.n - target)  # the prescribed mean gap's error, over sqrt(m0^h)
+        converged = kkt.natural <= self.rtol and kkt.load_error <= self.rtol
         reason = outcome.reason
         if not converged and reason.startswith("CONVERGED"):
-            reason = f"NOT_CERTIFIED ({reason}, but on a fresh S g: natural residual {kkt.natural:.2g})"
+            reason = (f"NOT_CERTIFIED ({reason}, but on a fresh S g: natural residual {kkt.natural:.2g}, mean gap "
+                      f"error {kkt.load_error:.2g})")
         in_contact = (g == 0).astype(np.float64)
         measures = measure(problem, in_contact, g)
         pbar = -lam * problem.pressure_scale

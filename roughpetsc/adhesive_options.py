@@ -10,7 +10,7 @@ from .mode_settings import options_named
 OPTIONS = [
     ("adhesion", "none", "adhesive law: none | dugdale (tension -adhesion_stress up to the range w / sigma0) | "
                          "exponential (phi = -w exp(-g / rho), rho = -adhesion_range); periodic cell, displacement "
-                         "control (-gbar, -gbar_list), solved for the gap by projected CG"),
+                         "control (-gbar, -gbar_list), solved for the gap by projected CG (or -tao_type almm)"),
     ("adhesion_work", 0.0, "work of adhesion w, pressure x length units"),
     ("adhesion_stress", 0.0, "Dugdale stress sigma0, pressure units (or -adhesion_range h0, then sigma0 = w / h0)"),
     ("adhesion_range", 0.0, "range of the law, length units: rho (exponential) or h0 (dugdale)"),
@@ -31,7 +31,10 @@ def check(settings):
     if settings.control != "displacement":
         raise UserError(f"-{settings.load_option}: adhesive contact is solved under displacement control (it jumps "
                         "in and out of contact under load control); prescribe -gbar or -gbar_list")
-    for refused, given in (("tao_type", settings.tao_type), ("resume", settings.resume),
+    if settings.tao_type not in (None, "almm"):
+        raise UserError(f"-tao_type {settings.tao_type}: the adhesive problem is solved by its projected CG on the "
+                        "gap (no -tao_type) or by TAO ALMM with the mean-gap equality (-tao_type almm)")
+    for refused, given in (("resume", settings.resume),
                            ("hardness", settings.hardness), ("stress_depths", settings.stress_depths)):
         if given:
             raise UserError(f"-{refused} cannot be combined with -adhesion yet (the adhesive problem is solved by "
@@ -45,7 +48,8 @@ def make_solver(settings, problem):
     from .adhesive import AdhesiveContact
     from .solvers.tao_options import max_seconds
 
-    return AdhesiveContact(problem, settings.adhesion, settings.kkt_rtol, max_seconds=max_seconds(None))
+    return AdhesiveContact(problem, settings.adhesion, settings.kkt_rtol, max_seconds=max_seconds(None),
+                           solver=settings.tao_type or "gapcg")
 
 
 def summary(law, statistics, E_star):

@@ -205,3 +205,28 @@ def test_command_line_cycle_on_two_ranks_equals_one_rank(tmp_path):
     assert np.abs(p1 - p2).max() < 1e-8 * np.abs(p1).max()
     # Retraction holds more contact and less pressure than approach at the same mean gap (steps 1 and 3).
     assert area1[3] > area1[1] and pbar1[3] < pbar1[1]
+
+
+def test_tao_almm_meets_the_gap_cg():
+    """A second algorithm: TAO ALMM with the mean-gap equality reaches the projected CG's solution.
+
+    Weak exponential adhesion, where the local minimum next to both starts is the same one.
+    """
+    grid = Grid(32, 32, 1.0, 1.0)
+    heights = fractal(grid, 2, 8, 0.8, 1e-2, seed=4)
+    law = Exponential(5e-6, 1e-3)
+    answers = []
+    for solver in ("gapcg", "almm"):
+        problem = ContactProblem(grid, heights, 1.0, fft_effort="FFTW_ESTIMATE")
+        adhesive = AdhesiveContact(problem, law, rtol=1e-9, solver=solver)
+        try:
+            result = adhesive.solve(8e-3)
+            assert result.converged, result.reason
+            answers.append((result, adhesive.fields()[0]))
+        finally:
+            adhesive.destroy()
+            problem.destroy()
+    (cg, p_cg), (almm, p_almm) = answers
+    assert almm.A == cg.A and almm.A > 0
+    assert np.abs(p_almm - p_cg).max() < 1e-7 * np.abs(p_cg).max()
+    assert almm.pbar == pytest.approx(cg.pbar, rel=1e-7)

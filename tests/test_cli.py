@@ -109,6 +109,8 @@ BAD_INPUTS = [
      "-pstar"),
     (lambda t: ["-adhesion", "exponential", "-adhesion_work", 1e-7, "-adhesion_range", 1e-5, "-gbar", 1e-4,
                 "-boundary", "free"], 1, "-boundary"),
+    (lambda t: ["-adhesion", "exponential", "-adhesion_work", 1e-7, "-adhesion_range", 1e-5, "-gbar", 1e-4,
+                "-tao_type", "bqnls"], 1, "-tao_type"),
 ]
 
 

@@ -13,6 +13,20 @@ from .registry import register
 from .tao_options import DEFAULT_MAX_IT, set_from_options
 
 
+def mean_jacobian(constraint, vec, n, comm):
+    """The Jacobian of the mean of a Vec laid out like ``vec``: one dense row of 1/n, owned by rank 0.
+
+    ``constraint`` is the one-entry constraint Vec (its row is on rank 0) of an equality on the mean.
+    """
+    jacobian = PETSc.Mat().createDense(((constraint.getLocalSize(), 1), (vec.getLocalSize(), n)), comm=comm)
+    jacobian.setUp()
+    start, end = vec.getOwnershipRange()
+    columns = np.arange(start, end, dtype=PETSc.IntType)
+    jacobian.setValues([0], columns, np.full(columns.size, 1.0 / n))
+    jacobian.assemble()
+    return jacobian
+
+
 class ALMMLoad(Backend):
     """Load control by TAO ALMM: ``min 1/2 p'Kp - p'h`` with ``p >= 0`` and ``mean(p) = pbar``.
 
@@ -41,7 +55,7 @@ class ALMMLoad(Backend):
         self.upper = problem.vec()
         self.upper.set(PETSc.INFINITY if problem.upper_bound is None else problem.upper_bound)
         self.constraint = PETSc.Vec().createMPI((1 if comm.getRank() == 0 else 0, 1), comm=comm)
-        self.jacobian = self._mean_jacobian()
+        self.jacobian = mean_jacobian(self.constraint, self.gradient, problem.n, comm)
         tao = self.tao = PETSc.TAO().create(comm)
         tao.setOptionsPrefix(settings.prefix)
         tao.setType("almm")
@@ -53,19 +67,6 @@ class ALMMLoad(Backend):
         tao.setTolerances(gatol=0.0, grtol=0.0, gttol=0.0)
         tao.setMaximumIterations(DEFAULT_MAX_IT)
         set_from_options(tao, self.destroy)
-
-    def _mean_jacobian(self):
-        """The Jacobian of mean(p) - pbar: one dense row of 1/n, owned by rank 0."""
-        problem = self.problem
-        rows = self.constraint.getLocalSize()
-        n_local = problem.operator.local_shape[0] * problem.operator.local_shape[1]
-        jacobian = PETSc.Mat().createDense(((rows, 1), (n_local, problem.n)), comm=problem.comm)
-        jacobian.setUp()
-        start, end = self.gradient.getOwnershipRange()
-        columns = np.arange(start, end, dtype=PETSc.IntType)
-        jacobian.setValues([0], columns, np.full(columns.size, 1.0 / problem.n))
-        jacobian.assemble()
-        return jacobian
 
     def _objective_gradient(self, tao, x, gradient):
         objective = self.objective.evaluate(x, gradient)
