@@ -78,15 +78,18 @@ def report(comm, pressure, gap, n_total, target_pbar=None, upper=None):
     scale = target_pbar if target_pbar else (mean_p if mean_p > 0 else 1.0)
     if upper is None:
         residual = np.minimum(pressure / scale, gap)
-        below_cap = gap
     else:
-        # mid(a, b, c) = max(min(a, b), min(max(a, b), c)) with a = p, b = g, c = p - H (a > c).
-        low, high = pressure / scale, (pressure - upper) / scale
-        residual = np.maximum(np.minimum(low, gap), np.minimum(np.maximum(low, gap), high))
-        below_cap = gap[pressure < upper]
-        sum_pg, = allsum(comm, [np.dot(pressure[pressure < upper], below_cap)])
+        # mid(p, g, p - H) = clip(g, p - H, p) since p - H < p (in units of the scale); this runs every
+        # iteration of a capped solve, so it is built in two arrays.
+        residual = pressure / scale
+        high = residual - upper / scale
+        np.clip(gap, high, residual, out=residual)
+        below = np.less(pressure, upper)
+        np.multiply(pressure, gap, out=high)
+        sum_pg, = allsum(comm, [high.sum(where=below)])
     natural, = allmax(comm, [np.abs(residual).max(initial=0.0)])
-    min_p, min_g = allmin(comm, [pressure.min(initial=np.inf), below_cap.min(initial=np.inf)])
+    min_g_local = gap.min(initial=np.inf) if upper is None else gap.min(where=below, initial=np.inf)
+    min_p, min_g = allmin(comm, [pressure.min(initial=np.inf), min_g_local])
     return KKTReport(
         natural=float(natural),
         complementarity=float(sum_pg / sum_p) if sum_p > 0 else 0.0,

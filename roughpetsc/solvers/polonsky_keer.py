@@ -156,6 +156,8 @@ class PolonskyKeer:
         precondition = self.preconditioner == "fourier"
         contact = np.empty_like(p)  # 1.0 on the contact set, 0.0 elsewhere: masks as dot products
         negative = np.empty(p.shape, dtype=bool)  # scratch mask, so the loop allocates no N^2 temporaries
+        at_cap = np.empty(p.shape, dtype=bool) if upper is not None else None
+        opening = np.empty(p.shape, dtype=bool) if upper is not None else None
         t[...] = 0.0
         if not load_control:
             self.separation = self.target_separation
@@ -178,7 +180,8 @@ class PolonskyKeer:
             fresh = since_fresh == 0
             np.greater(p, 0.0, out=contact)
             if upper is not None:
-                np.copyto(contact, 0.0, where=p >= upper)  # plastic nodes: their gap may be negative
+                np.greater_equal(p, upper, out=at_cap)
+                np.copyto(contact, 0.0, where=at_cap)  # plastic nodes: their gap may be negative
             np.subtract(displacement, h, out=gap)
             if load_control:
                 # d is fixed by a zero mean gap on the (elastic) contact set: g = K p - h + d.
@@ -212,11 +215,13 @@ class PolonskyKeer:
             if bccg:
                 np.less(gap, 0.0, out=negative)
                 if upper is not None:
-                    negative &= p < upper
+                    np.copyto(negative, False, where=at_cap)
                 np.copyto(contact, 1.0, where=negative)
             if upper is not None:
                 # Plastic nodes whose gap opens leave the cap: they join the free set.
-                np.copyto(contact, 1.0, where=(p >= upper) & (gap > 0.0))
+                np.greater(gap, 0.0, out=opening)
+                opening &= at_cap
+                np.copyto(contact, 1.0, where=opening)
             if bccg or not load_control:
                 count, gap_sum = allsum(mpi, [contact.sum(), np.dot(gap, contact)])
             else:
