@@ -153,12 +153,14 @@ class AdhesiveContact:
         return float(sums.sum() / self.problem.n)
 
     # --- solves ---------------------------------------------------------------
-    def solve(self, gbar=None, pbar=None, pstar=None):
+    def solve(self, gbar=None, pbar=None, pstar=None, start=None):
         """Solve at the mean gap ``gbar`` (length units) from the last solution; a :class:`Result`.
 
         The first solve starts from the rigid gap max(gbar - h, 0) shifted to mean gbar; later ones from
-        the previous gap shifted by the change of gbar (both projected onto g >= 0, mean gbar). A load
-        (``pbar``, ``pstar``) is refused: adhesive contact is solved under displacement control.
+        the previous gap shifted by the change of gbar (both projected onto g >= 0, mean gbar).
+        ``start="rigid"`` or ``"uniform"`` (g = gbar everywhere, the start of Tamaas' solver) forces a
+        start: the local minimum a non-convex problem reaches depends on it. A load (``pbar``,
+        ``pstar``) is refused: adhesive contact is solved under displacement control.
         """
         if gbar is None:
             raise ParameterError("pbar" if pstar is None else "pstar",
@@ -169,7 +171,12 @@ class AdhesiveContact:
         problem = self.problem
         target = gbar / problem.height_scale
         g = problem.local(self.gap)
-        if not self.started:
+        if start not in (None, "rigid", "uniform"):
+            raise ParameterError("start", f"the start is 'rigid' or 'uniform', got '{start}'")
+        if start == "uniform":
+            g[...] = target
+            self.started = True
+        elif start == "rigid" or not self.started:
             g[...] = target - problem.local(problem.heights, readonly=True)
             self.started = True
         else:

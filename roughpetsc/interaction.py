@@ -130,12 +130,8 @@ def tabor_parameter(law, radius, E_star):
     """Tabor's parameter mu = (R w^2 / (E*^2 z0^3))^(1/3) with z0 the law's range (dimensionless).
 
     Large mu: the JKR limit (short-range adhesion, compliant bodies); small mu: the DMT limit. For
-    the Dugdale law Maugis's lambda = sigma0 (9 R / (2 pi w E*^2))^(1/3) = (9 / (2 pi))^(1/3) mu
-    is the usual form (:func:`maugis_parameter`).
+    the Dugdale law Maugis's lambda (:func:`roughpetsc.models.sphere_adhesion.maugis_parameter`) is
+    the usual form.
     """
     return (radius * law.work ** 2 / (E_star ** 2 * law.range ** 3)) ** (1.0 / 3.0)
 
-
-def maugis_parameter(law, radius, E_star):
-    """Maugis's lambda = sigma0 (9 R / (2 pi w E*^2))^(1/3) with sigma0 the law's peak stress."""
-    return law.peak_stress * (9.0 * radius / (2.0 * math.pi * law.work * E_star ** 2)) ** (1.0 / 3.0)

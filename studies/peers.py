@@ -134,8 +134,12 @@ def run_ours(grid, heights, pairs, previous, pstar, rtol, repeats):
     return best, field
 
 
-def run_peer(peer, surface_path, pbar, tol, workdir, timeout, hardness=None):
-    """Solve with ``peer`` in its own virtualenv: (its JSON summary, its pressure field)."""
+def run_peer(peer, surface_path, pbar, tol, workdir, timeout, hardness=None, adhesion=None):
+    """Solve with ``peer`` in its own virtualenv: (its JSON summary, its pressure field).
+
+    ``adhesion``: ``(law, work, range)`` for Tamaas' adhesive gap solve (run_peer.py --adhesion); ``pbar`` is
+    then the prescribed mean gap and the summary gains the gap field under ``"gap"``.
+    """
     prefix = os.path.join(workdir, f"{peer}_{tol:.0e}")
     env = dict(os.environ)
     for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "FFTW_NUM_THREADS"):
@@ -144,6 +148,9 @@ def run_peer(peer, surface_path, pbar, tol, workdir, timeout, hardness=None):
     command = [PEER_PYTHON, RUN_PEER, surface_path, "1.0", repr(pbar), peer, repr(tol), prefix]
     if hardness is not None:
         command += ["--hardness", repr(hardness)]
+    if adhesion is not None:
+        law, work, range_ = adhesion
+        command += ["--adhesion", law, "--work", repr(work), "--range", repr(range_)]
     completed = subprocess.run(command, cwd=workdir, env=env, capture_output=True, text=True, timeout=timeout)
     if completed.returncode != 0:
         raise RuntimeError(f"{peer} at tol {tol:g} failed:\n{completed.stderr[-3000:]}")
@@ -151,6 +158,9 @@ def run_peer(peer, surface_path, pbar, tol, workdir, timeout, hardness=None):
         info = json.load(f)
     field = np.load(prefix + ".npy")
     os.remove(prefix + ".npy")
+    if adhesion is not None:
+        info["gap"] = np.load(prefix + ".gap.npy")
+        os.remove(prefix + ".gap.npy")
     return info, field
 
 

@@ -21,9 +21,12 @@ hertz, crack
     Hertz elliptical contact (4.6)-(4.17); pressurised elliptical/penny crack (5.15)-(5.32).
 AdhesiveCrack(sigma0), AdhesiveGW(...), jkr_*
     Penny-shaped adhesive crack (6.1)-(6.39) and adhesive adapted GW (6.40)-(6.54).
+sphere_adhesion, wavy_adhesion
+    Closed forms that validate the adhesive BEM: a sphere (JKR, DMT, Maugis-Dugdale) and Johnson's wavy
+    surface (JKR, and a Maugis-Dugdale counterpart, ``WavyMaugisDugdale``).
 """
 
-from . import crack, hertz, pdfs, quadrature
+from . import crack, hertz, pdfs, quadrature, sphere_adhesion, wavy_adhesion
 from .adhesion import (AdhesiveCrack, AdhesiveGW, jkr_G, jkr_pmin, jkr_pstar,
                        jkr_radius, jkr_volume, nonadhesive_area,
                        nonadhesive_radius, nonadhesive_volume)

@@ -85,7 +85,9 @@ class AdhesiveALMM:
         reason = reason_name(self.tao.getConvergedReason())
         notes = [self.test.stopped_by] if self.test.stopped_by else []
         if self.tao.getConvergedReason() < 0 and np.isfinite(self.test.best):
+            self.test.best_iterate.copy(adhesive.gap)  # the caller certifies it afresh
             notes.append(f"best natural residual {self.test.best:.2g}")
+        self.test.best_iterate.destroy()
         return Outcome(separation=target, iterations=self.tao.getIterationNumber(),
                        reason=f"{reason} ({', '.join(notes)})" if notes else reason,
                        history=self.test.history.as_array())
@@ -106,6 +108,7 @@ class _NaturalTest:
         self.elastic_vec = elastic_vec
         self.history = History(adhesive.problem)
         self.best, self.best_iteration, self.stopped_by = np.inf, 0, None
+        self.best_iterate = adhesive.problem.vec()  # returned by a stop short of the tolerance
 
     def __call__(self, tao):
         adhesive = self.adhesive
@@ -124,6 +127,7 @@ class _NaturalTest:
         self.history.record(iteration, natural)
         if natural < self.best:
             self.best, self.best_iteration = natural, iteration
+            x.copy(self.best_iterate)
         if natural <= adhesive.rtol:
             tao.setConvergedReason(PETSc.TAO.Reason.CONVERGED_USER)
         elif self.history.out_of_time(adhesive.max_seconds):

@@ -16,7 +16,7 @@ as the unknown and the mean gap as the constraint, with three changes of ours:
 
 After each step the gap is projected onto {g >= 0, mean g = gbar} exactly (a shift of the positive
 nodes found by Newton's method on a piecewise-linear function). Every stop is decided on a freshly
-computed S g.
+computed S g; a stop short of the tolerance returns the iterate of the lowest residual.
 """
 
 import numpy as np
@@ -72,6 +72,7 @@ class _Scratch:
         self.free = np.empty(size)
         self.open = np.empty(size, dtype=bool)
         self.mask = np.empty(size, dtype=bool)
+        self.best = np.empty(size)  # the iterate of the lowest natural residual, returned by a stop short of it
 
 
 def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, previous_vec):
@@ -109,6 +110,7 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
             break
         if natural < best:
             best, best_iteration = natural, iteration
+            np.copyto(scratch.best, g)
         if iteration >= adhesive.max_iter:
             break
         if history.out_of_time(adhesive.max_seconds):
@@ -164,6 +166,7 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
         iteration += 1
     notes = [stopped_by] if stopped_by else []
     if not reason.startswith("CONVERGED") and np.isfinite(best):
+        np.copyto(g, scratch.best)  # the caller certifies it afresh
         notes.append(f"best natural residual {best:.2g}")
     return Outcome(separation=target, iterations=iteration,
                    reason=f"{reason} ({', '.join(notes)})" if notes else reason, history=history.as_array())

@@ -8,6 +8,17 @@ Writes ``OUT_PREFIX.npy`` (the pressure field, pressure units, same layout as th
 surface) and ``OUT_PREFIX.json`` (A* by node count, gbar, iterations, solve and
 setup wall time, versions, the peer's own error measure).
 
+ADHESIVE mode (Tamaas only; displacement control by the imposed mean gap G):
+
+    .peers-venv/bin/python studies/peers/run_peer.py SURFACE.npy E_STAR G tamaas TOL OUT_PREFIX \
+        --adhesion exponential|maugis|none --work W --range RHO [--mean-gap G] [--length L]
+
+It runs PolonskyKeerRey with the gap as primal and the mean gap as constraint, plus Tamaas'
+Exponential/Maugis adhesion functional (Rey-Anciaux-Molinari). The third positional is the mean
+gap (--mean-gap overrides it). It writes OUT_PREFIX.npy (the total normal traction, compressive
+positive, adhesive tensile negative), OUT_PREFIX.gap.npy (the gap g >= 0) and OUT_PREFIX.json.
+The conventions are in solve_tamaas_adhesion's docstring.
+
 It never imports roughpetsc: the peers live in their own virtualenv with their own numpy.
 
 Both peers are set up on OUR discrete problem (docs/conventions.md, eq. 3.33): a periodic
@@ -52,18 +63,28 @@ def _version(distribution, fallback):
         return str(fallback)
 
 
-def solve_tamaas(heights, e_star, pbar, tol, length, max_iter):
+def _tamaas_solver(heights, e_star, tol, length, max_iter, primal):
+    """Tamaas' basic_2d model (E = E*, nu = 0) and a PolonskyKeerRey on ``primal`` ("pressure" or "gap"),
+    constrained on the same variable; returns (model, surface, solver), log level error."""
     import tamaas as tm
 
     tm.set_log_level(tm.LogLevel.error)
-    start = time.perf_counter()
     n0, n1 = heights.shape
     model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [length, length * n1 / n0], [n0, n1])
     model.E = e_star
     model.nu = 0.0
     surface = np.ascontiguousarray(heights, dtype=np.float64)
-    solver = tm.PolonskyKeerRey(model, surface, tol, tm.PolonskyKeerRey.pressure, tm.PolonskyKeerRey.pressure)
+    variable = getattr(tm.PolonskyKeerRey, primal)
+    solver = tm.PolonskyKeerRey(model, surface, tol, variable, variable)
     solver.max_iter = max_iter
+    return model, surface, solver
+
+
+def solve_tamaas(heights, e_star, pbar, tol, length, max_iter):
+    import tamaas as tm
+
+    start = time.perf_counter()
+    model, surface, solver = _tamaas_solver(heights, e_star, tol, length, max_iter, "pressure")
     # Iterations: at log level info PKR prints (to stderr, from C++) a table row at
     # iteration 0, every dump_freq iterations and at the last one; with a huge
     # dump_freq only the first and the last rows are printed. Capture fd 2.
@@ -78,7 +99,7 @@ def solve_tamaas(heights, e_star, pbar, tol, length, max_iter):
     rows = [line.split() for line in log.text.splitlines()]
     counts = [int(r[0]) for r in rows if len(r) == 3 and r[0].isdigit()]
     iterations = counts[-1] if counts else None
-    pressure = np.array(model.traction, dtype=np.float64).reshape(n0, n1)
+    pressure = np.array(model.traction, dtype=np.float64).reshape(heights.shape)
     return {
         "pressure": pressure,
         "iterations": iterations,
@@ -113,6 +134,156 @@ class _CaptureStderr:
         self.text = self._file.read().decode(errors="replace")
         self._file.close()
         return False
+
+
+ADHESION_LAWS = ("exponential", "maugis", "none")
+
+
+def _adhesion_law(law, work, range_):
+    """(phi(g), phi'(g)) of Tamaas' adhesion functionals, per unit area (see solve_tamaas_adhesion)."""
+    if law == "exponential":
+        return (lambda g: -work * np.exp(-g / range_)), (lambda g: work / range_ * np.exp(-g / range_))
+    if law == "maugis":
+        return ((lambda g: np.where(g <= range_, -work * (1.0 - g / range_), 0.0)),
+                (lambda g: np.where(g <= range_, work / range_, 0.0)))
+    return (lambda g: np.zeros_like(g)), (lambda g: np.zeros_like(g))
+
+
+def solve_tamaas_adhesion(heights, e_star, mean_gap, law, work, range_, tol, length, max_iter):
+    """Adhesive contact at imposed mean gap with Tamaas' PolonskyKeerRey (gap primal, gap constraint).
+
+    This is the algorithm of Rey, Anciaux & Molinari (2017): PolonskyKeerRey(model, h, tol,
+    PolonskyKeerRey.gap, PolonskyKeerRey.gap) plus addFunctionalTerm(<law>AdhesionFunctional).
+    Tamaas 2.9's C++ source is not shipped in the wheel (only _tamaas.so, built from upstream
+    src/solvers/polonsky_keer_rey.cpp and the tamaas::functional adhesion classes). The
+    conventions below come from the pybind docstrings, from calling the functionals'
+    computeF/computeGradF on known gaps, and from a numpy re-implementation of the gap-primal
+    loop. That re-implementation reproduces Tamaas' gap field to 1e-16 and its logged error to
+    all printed digits at every iteration, for no adhesion, exponential and Maugis.
+
+    Model: basic_2d, model.E = E*, nu = 0 (E_star = E/(1-nu^2) = E*), the same Westergaard kernel
+    as solve_tamaas. Gradients are pointwise (stress units). The Dirichlet stiffness of the
+    elastic part is pi E* |k| (k in cycles per length) with a zero k = 0 mode.
+
+    Energies: each functional's computeF sums its energy over the nodes, and its computeGradF
+    ADDS the gradient pointwise. With w = parameters['surface_energy'] (energy per unit area,
+    the work of adhesion: phi(0) = -w, phi(inf) = 0) and rho = parameters['rho'] (a length):
+      * ExponentialAdhesionFunctional ("F = -γ·exp(-g/ρ)"): phi(g) = -w exp(-g/rho),
+        phi'(g) = (w/rho) exp(-g/rho); its peak tensile stress is w/rho, at g = 0.
+      * MaugisAdhesionFunctional: the docstring "F = H(g - ρ)·γ/ρ" is misleading. What it
+        computes is the Dugdale/Maugis law phi(g) = -w (1 - g/rho) for g <= rho (the bound
+        included) and 0 beyond; phi'(g) = w/rho (constant stress sigma0 = w/rho) for g <= rho,
+        0 beyond.
+    ElasticFunctionalGap: F = 0.5 mean((g+h) K(g+h)) (energy PER UNIT AREA) and gradF = K(g+h).
+    So Tamaas' printed Cost_f mixes a mean (elastic) with a node sum (adhesion) and is not an
+    energy. The solver uses only the gradients, which are consistent. The equilibrium solved is
+    K u + phi'(g) = lambda + c, lambda >= 0, g >= 0, lambda g = 0, where the constant c carries
+    the mean-gap constraint. So w is per unit area, and the discrete problem does not depend on
+    the pixel area. The functionals' `surface` argument only gives the shape.
+
+    solve(mean_gap), gap primal: the initial g is uniform and equal to mean_gap. Each iteration
+    (the primal update order is from memory of PolonskyKeerRey::updatePrimal; the steps were
+    confirmed by the 1e-16 reproduction):
+      1. d = K(g+h) + phi'(g);
+      2. d -= mean of d over {g > 0} (meanOnUnsaturated);
+      3. conjugate direction on {g > 0}; step tau from K applied to the direction;
+      4. g -= tau*dir, projected with max(g, 0); nodes with g == 0 and d < 0 are reopened
+         (g = -tau d);
+      5. enforceMeanValue: g *= mean_gap / mean(g), so the MEAN GAP (a length, in the
+         heights' units) is imposed exactly.
+    Contact gaps are exact zeros. The mean of g is mean_gap, whatever mean(h) is.
+
+    After solve (enforceAdmissibleState):
+      * model.displacement = g + h;
+      * model.traction = K(g+h) - min_i[K(g+h) + phi'(g)]_i. This is the TOTAL normal traction,
+        compressive positive and adhesive (tensile) negative. It is Neumann-consistent with the
+        displacement (u - N(t) is constant) and equals -phi'(g) on g > 0. Its mean, the mean
+        pressure, is -min(d), which is set by the constraint multiplier.
+    In our convention (u with zero mean, g = u + d - h), u = u_tamaas - mean(u_tamaas) and the
+    mean-plane separation is d = mean_gap + mean(h).
+
+    Error (PolonskyKeerRey::computeError, gap primal):
+        err = |sum_i g_i (d_i - min_j d_j)| / (|sum_i d_i| * std(h, ddof=1)).
+    Here d is the dbar-shifted gradient of step 2, taken BEFORE the update, and g is the
+    updated primal. sum d ~ the total contact (repulsive) force in nodal units, so err is a
+    multiplier-weighted mean gap over std(h). The loop stops when err <= tol or after max_iter
+    + 1 updates. If nothing is in contact, sum d = 0 and err ~ 1e16-1e18: such a state never
+    'converges' and runs to max_iter even when its field is right (flagged as no_contact).
+
+    Contact area: the fraction of nodes with g == 0 exactly. The projection writes exact zeros,
+    and u - h recovers them exactly. A_gap_le_1e-12sigma is reported as a check.
+    Iterations: 'iterations' is Tamaas' last logged counter, the convention of solve_tamaas. It
+    is the number of primal updates minus 1 when converged, and equals it when max_iter stopped
+    the run. 'primal_updates' is the exact count.
+    """
+    import tamaas as tm
+
+    if law not in ADHESION_LAWS:
+        raise ValueError(f"law must be one of {ADHESION_LAWS}")
+    if law != "none" and not (work >= 0 and range_ > 0):
+        raise ValueError("need work >= 0 and range > 0")
+    start = time.perf_counter()
+    model, surface, solver = _tamaas_solver(heights, e_star, tol, length, max_iter, "gap")
+    functional = None
+    if law != "none":
+        cls = {"exponential": tm.ExponentialAdhesionFunctional, "maugis": tm.MaugisAdhesionFunctional}[law]
+        functional = cls(surface)
+        functional.parameters = {"rho": float(range_), "surface_energy": float(work)}
+        solver.addFunctionalTerm(functional)  # `functional` stays referenced until the end
+    tm.set_log_level(tm.LogLevel.info)
+    solver.dump_freq = 10 ** 9  # only the first and the final rows (see solve_tamaas)
+    setup = time.perf_counter() - start
+    with _CaptureStderr() as log:
+        start, cpu = time.perf_counter(), time.process_time()
+        error = solver.solve(float(mean_gap))
+        solve_time, cpu = time.perf_counter() - start, time.process_time() - cpu
+    tm.set_log_level(tm.LogLevel.error)
+    rows = [line.split() for line in log.text.splitlines()]
+    counts = [int(r[0]) for r in rows if len(r) == 3 and r[0].isdigit()]
+    converged = bool(error <= tol)
+    iterations = counts[-1] if counts else None
+    updates = None if iterations is None else iterations + (1 if converged else 0)
+
+    pressure = np.array(model.traction, dtype=np.float64).reshape(heights.shape)
+    displacement = np.array(model.displacement, dtype=np.float64).reshape(heights.shape)
+    gap = displacement - surface
+    phi, dphi = _adhesion_law(law, work, range_)
+    contact = gap == 0.0
+    free = ~contact
+    sigma = float(np.std(surface))
+    # Checks: the traction on g > 0 must be -phi'(g), and lambda = p + phi'(g) >= 0 on contact.
+    free_residual = float(np.abs(pressure + dphi(gap))[free].max()) if free.any() else 0.0
+    multiplier_min = float((pressure + dphi(gap))[contact].min()) if contact.any() else None
+    u0 = displacement - displacement.mean()
+    return {
+        "pressure": pressure,
+        "gap": gap,
+        "iterations": iterations,
+        "primal_updates": updates,
+        "peer_error": float(error),
+        "converged": converged,
+        "no_contact": bool(not contact.any()),
+        "setup_s": setup,
+        "solve_s": solve_time,
+        "cpu_s": cpu,
+        "version": _version("tamaas", tm.__version__),
+        "A": float(np.count_nonzero(contact) / gap.size),
+        "A_gap_le_1e-12sigma": float(np.count_nonzero(gap <= 1e-12 * sigma) / gap.size),
+        "A_pressure_positive": float(np.count_nonzero(pressure > 0) / gap.size),
+        "pbar_out": float(pressure.mean()),
+        "pbar_repulsive": float(np.maximum(pressure, 0).mean()),
+        "pbar_tensile": float(np.minimum(pressure, 0).mean()),
+        "mean_gap_out": float(gap.mean()),
+        "d_separation": float(mean_gap + surface.mean()),
+        "energy_elastic_per_area": float(0.5 * np.mean(u0 * pressure)),
+        "energy_adhesive_per_area": float(np.mean(phi(gap))),
+        "check_free_traction_residual": free_residual,
+        "check_min_contact_multiplier": multiplier_min,
+        "settings": {"tolerance": tol, "max_iter": max_iter, "primal": "gap", "constraint": "gap",
+                     "mean_gap": mean_gap, "law": law, "surface_energy": work, "rho": range_,
+                     "E": e_star, "nu": 0.0, "contact": "gap == 0",
+                     "error": "|sum g (d - min d)| / (|sum d| std(h, ddof=1))"},
+    }
 
 
 def solve_contactmechanics(heights, e_star, pbar, tol, length, max_iter, hardness=None):
@@ -199,6 +370,14 @@ def main():
                         help="contactmechanics only: the pressure cap H (perfect plasticity, CCG's hardness)")
     parser.add_argument("--check-kernels", action="store_true",
                         help="only compare both peers' compliance with 1/(pi E* |k|) and exit")
+    parser.add_argument("--adhesion", choices=ADHESION_LAWS, default=None,
+                        help="tamaas only: adhesive contact at imposed mean gap (gap primal); "
+                             "'none' = the same displacement-controlled solve without adhesion")
+    parser.add_argument("--work", type=float, default=None, help="--adhesion: work of adhesion w (energy/area)")
+    parser.add_argument("--range", dest="range_", type=float, default=None,
+                        help="--adhesion: range rho (length)")
+    parser.add_argument("--mean-gap", type=float, default=None,
+                        help="--adhesion: imposed mean gap (length); if omitted, the PBAR positional is used")
     args = parser.parse_args()
     if args.check_kernels:
         print(json.dumps(check_kernels(), indent=1))
@@ -208,6 +387,31 @@ def main():
     heights = np.load(args.surface)
     if heights.ndim != 2 or not np.all(np.isfinite(heights)):
         sys.exit(f"{args.surface}: need a finite 2-D height array")
+    if args.adhesion is not None:
+        if args.peer != "tamaas" or args.hardness is not None:
+            sys.exit("--adhesion: only with tamaas and without --hardness")
+        mean_gap = args.pbar if args.mean_gap is None else args.mean_gap
+        if args.mean_gap is not None and args.pbar != args.mean_gap:
+            print(f"note: PBAR positional {args.pbar} ignored, --mean-gap {args.mean_gap} used", file=sys.stderr)
+        if args.adhesion != "none" and (args.work is None or args.range_ is None):
+            parser.error("--adhesion exponential|maugis needs --work and --range")
+        result = solve_tamaas_adhesion(heights, args.e_star, mean_gap, args.adhesion,
+                                       0.0 if args.work is None else args.work,
+                                       1.0 if args.range_ is None else args.range_,
+                                       args.tol, args.length, args.max_iter)
+        pressure, gap = result.pop("pressure"), result.pop("gap")
+        result.update({
+            "peer": "tamaas", "mode": "adhesion", "n": list(pressure.shape), "numpy": np.__version__,
+            "threads_env": {k: os.environ.get(k) for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+                                                          "MKL_NUM_THREADS", "FFTW_NUM_THREADS")},
+        })
+        np.save(args.out + ".npy", pressure)
+        np.save(args.out + ".gap.npy", gap)
+        with open(args.out + ".json.tmp", "w") as f:
+            json.dump(result, f, indent=1)
+        os.replace(args.out + ".json.tmp", args.out + ".json")
+        print(json.dumps(result))
+        return
     if args.peer == "tamaas":
         if args.hardness is not None:
             sys.exit("--hardness: only with contactmechanics")
