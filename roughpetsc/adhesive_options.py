@@ -71,3 +71,20 @@ def header(law, summary):
     """The header line of an adhesive run."""
     return (f"  {law.describe()}; Tabor parameter mu = {summary['tabor']:.4g} "
             f"(summit radius {summary['summit_radius']:.4g})")
+
+
+def close_cycle(record, say):
+    """A path that returns to its first mean gap is a cycle: its dissipated energy into the summary, and said.
+
+    The energy per unit area -closed integral of pbar dgbar (:func:`roughpetsc.adhesive.dissipated_energy`),
+    pressure x length units; nothing for a path that does not return.
+    """
+    from .adhesive import dissipated_energy
+
+    steps = record.steps
+    gaps = [step["gbar"] for step in steps]
+    if len(steps) < 3 or abs(gaps[0] - gaps[-1]) > 1e-12 * abs(gaps[0]):
+        return
+    energy = dissipated_energy(gaps, [step["pbar"] for step in steps])
+    record.summary["adhesion"]["dissipated_energy"] = energy
+    say(f"  cycle of {len(steps) - 1} steps: energy dissipated per unit area {energy:.6g} (pressure x length)")

@@ -286,6 +286,8 @@ def run(reader, comm):
                 print(f"roughpetsc: interrupted after {len(record.steps)} of {len(settings.steps)} step(s){kept}",
                       file=sys.stderr, flush=True)
             return 130
+        if settings.adhesion is not None:
+            adhesive_options.close_cycle(record, say)
         whole = whole_last_fields(record, comm, distributed, settings)
         if settings.stress_depths:
             io.on_root(comm, record_stresses, settings, record, grid, whole)

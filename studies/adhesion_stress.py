@@ -34,7 +34,7 @@ from stress_grid import independent, surface
 RTOLS = (1e-8, 1e-10, 1e-12)
 CASES = {"strong exponential": ("exponential", 0.2, 1.0), "short exponential": ("exponential", 0.01, 1.0),
          "strong dugdale": ("dugdale", 0.2, 1.0), "near pull-off": ("dugdale", 0.2, 1.0)}
-NAMED = re.compile(r"best natural residual|time limit|stagnation|round-off|no decrease")
+NAMED = re.compile(r"best (of )?natural residual|time limit|stagnation|round-off|no decrease")
 
 
 def make_law(kind, problem, range_, peak):

@@ -7,6 +7,7 @@ they apply.
 """
 
 import contextlib
+import json
 import math
 import os
 import subprocess
@@ -205,6 +206,21 @@ def test_command_line_cycle_on_two_ranks_equals_one_rank(tmp_path):
     assert np.abs(p1 - p2).max() < 1e-8 * np.abs(p1).max()
     # Retraction holds more contact and less pressure than approach at the same mean gap (steps 1 and 3).
     assert area1[3] > area1[1] and pbar1[3] < pbar1[1]
+
+
+def test_command_line_cycle_reports_its_dissipated_energy(tmp_path):
+    """A -gbar_list that returns to its start is a cycle: the energy it dissipated is said and recorded."""
+    path = tmp_path / "cycle.h5"
+    out = run_cli(["-surface_N", 48, "-surface_ks", 12, "-surface_kl", 2, "-adhesion", "exponential",
+                   "-adhesion_work", 2e-7, "-adhesion_range", 2e-5, "-gbar_list", "2e-4,1e-4,5e-5,1e-4,2e-4",
+                   "-fft_effort", "FFTW_ESTIMATE", "-output", path], timeout=120)
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "energy dissipated per unit area" in out.stdout
+    with h5py.File(path) as f:
+        recorded = json.loads(f.attrs["adhesion"])["dissipated_energy"]
+        steps = [f[f"steps/{i:03d}"].attrs for i in range(5)]
+        gbars, pbars = [s["gbar"] for s in steps], [s["pbar"] for s in steps]
+    assert recorded == pytest.approx(dissipated_energy(gbars, pbars), rel=1e-12) and recorded > 0
 
 
 def test_tao_almm_meets_the_gap_cg():

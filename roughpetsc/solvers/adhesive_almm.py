@@ -86,7 +86,7 @@ class AdhesiveALMM:
         notes = [self.test.stopped_by] if self.test.stopped_by else []
         if self.tao.getConvergedReason() < 0 and np.isfinite(self.test.best):
             self.test.best_iterate.copy(adhesive.gap)  # the caller certifies it afresh
-            notes.append(f"best natural residual {self.test.best:.2g}")
+            notes.append(f"best of natural residual, mean gap error {self.test.best:.2g}")
         self.test.best_iterate.destroy()
         return Outcome(separation=target, iterations=self.tao.getIterationNumber(),
                        reason=f"{reason} ({', '.join(notes)})" if notes else reason,
