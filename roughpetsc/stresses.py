@@ -20,27 +20,52 @@ from .fftw import planner_effort
 COMPONENTS = ("xx", "yy", "zz", "xy", "yz", "xz")
 
 
-def transfer_functions(k0, k1, depth, nu):
-    """The six transfer functions of (3.26) at ``depth`` on wavenumbers ``(k0, k1)`` (cycles/length).
+class PeriodicTransfer:
+    """The transfer functions (3.26) on wavenumbers ``(k0, k1)`` (cycles/length), their depth-free parts made once.
 
-    ``k0`` runs along axis 0 (``y``), ``k1`` along axis 1 (``x``). Returns a dict of complex
-    arrays (zero at ``k = 0``, see the module docstring) keyed by :data:`COMPONENTS`.
+    ``k0`` runs along axis 0 (``y``), ``k1`` along axis 1 (``x``). Each normal and in-plane transfer is
+    ``decay (a + kz b)`` with ``decay = exp(-2 pi |k| z)``, ``kz = 2 pi |k| z`` and depth-free ``a``,
+    ``b``; the shear ones are ``2 pi i k_{x,y} z decay``. All are zero at ``k = 0`` (module docstring).
     """
-    ky, kx = np.broadcast_arrays(k0, k1)
-    k = np.hypot(kx, ky)
-    positive = k > 0
-    safe = np.where(positive, k, 1.0)
-    decay = np.where(positive, np.exp(-2.0 * np.pi * safe * depth), 0.0)
-    cx2, cy2, cxy = kx * kx / safe ** 2, ky * ky / safe ** 2, kx * ky / safe ** 2
-    kz = 2.0 * np.pi * safe * depth
-    return {
-        "xx": -(cx2 - kz * cx2 + 2.0 * nu * cy2) * decay + 0j,
-        "yy": -(cy2 - kz * cy2 + 2.0 * nu * cx2) * decay + 0j,
-        "zz": -(1.0 + kz) * decay + 0j,
-        "xy": -cxy * (1.0 - 2.0 * nu - kz) * decay + 0j,
-        "yz": 2j * np.pi * ky * depth * decay,
-        "xz": 2j * np.pi * kx * depth * decay,
-    }
+
+    def __init__(self, k0, k1, nu):
+        ky, kx = np.broadcast_arrays(k0, k1)
+        k = np.hypot(kx, ky)
+        positive = k > 0
+        safe = np.where(positive, k, 1.0)
+        cx2, cy2, cxy = kx * kx / safe ** 2, ky * ky / safe ** 2, kx * ky / safe ** 2
+        self.two_pi_k = np.where(positive, 2.0 * np.pi * safe, 0.0)
+        self.zero_mode = ~positive
+        self.normal = {"xx": (-(cx2 + 2.0 * nu * cy2), cx2), "yy": (-(cy2 + 2.0 * nu * cx2), cy2),
+                       "zz": (-np.ones_like(k), -np.ones_like(k)), "xy": (-cxy * (1.0 - 2.0 * nu), cxy)}
+        self.shear = {"yz": 2.0 * np.pi * ky, "xz": 2.0 * np.pi * kx}
+
+    def apply(self, source, depth, out):
+        """Yield each component's name after writing ``out = transfer * source`` (complex spectra)."""
+        kz = self.two_pi_k * depth
+        decay = np.exp(-kz)
+        np.copyto(decay, 0.0, where=self.zero_mode)
+        factor = np.empty_like(decay)
+        for name, (a, b) in self.normal.items():
+            np.multiply(kz, b, out=factor)
+            factor += a
+            factor *= decay
+            np.multiply(source, factor, out=out)
+            yield name
+        for name, wavenumber in self.shear.items():
+            np.multiply(wavenumber, depth, out=factor)
+            factor *= decay
+            np.multiply(source, factor, out=out)
+            out *= 1j
+            yield name
+
+
+def transfer_functions(k0, k1, depth, nu):
+    """The six transfer functions of (3.26) at ``depth``: a dict of complex arrays keyed by :data:`COMPONENTS`."""
+    transfer = PeriodicTransfer(k0, k1, nu)
+    ones = np.ones(transfer.two_pi_k.shape, dtype=complex)
+    out = np.empty_like(ones)
+    return {name: out.copy() for name in transfer.apply(ones, depth, out)}
 
 
 def uniform_state(mean_pressure, nu):
@@ -50,9 +75,20 @@ def uniform_state(mean_pressure, nu):
 
 
 def von_mises(s):
-    """The von Mises equivalent stress of the components in dict ``s``."""
-    return np.sqrt(0.5 * ((s["xx"] - s["yy"]) ** 2 + (s["yy"] - s["zz"]) ** 2 + (s["zz"] - s["xx"]) ** 2)
-                   + 3.0 * (s["xy"] ** 2 + s["yz"] ** 2 + s["xz"] ** 2))
+    """The von Mises equivalent stress of the components in dict ``s`` (two arrays of scratch, no more)."""
+    total = np.subtract(s["xx"], s["yy"])
+    total *= total
+    difference = np.empty_like(total)
+    for first, second in (("yy", "zz"), ("zz", "xx")):
+        np.subtract(s[first], s[second], out=difference)
+        difference *= difference
+        total += difference
+    total *= 0.5
+    for name in ("xy", "yz", "xz"):
+        np.multiply(s[name], s[name], out=difference)
+        difference *= 3.0
+        total += difference
+    return np.sqrt(total, out=total)
 
 
 def max_shear(s):
@@ -124,10 +160,10 @@ def periodic_stresses(pressure, lengths, depths, nu):
     k0 = np.fft.fftfreq(n0, d=lengths[0] / n0)[:, None]
     k1 = np.fft.rfftfreq(n1, d=lengths[1] / n1)[None, :]
     uniform = uniform_state(float(pressure.mean()), nu)
+    transfer = PeriodicTransfer(k0, k1, nu)
     for depth in depths:
         components = {}
-        for name, transfer in transfer_functions(k0, k1, depth, nu).items():
-            np.multiply(pressure_spectrum, transfer, out=spectrum)
+        for name in transfer.apply(pressure_spectrum, depth, spectrum):
             backward.execute()
             components[name] = real + uniform[name]
         equivalent = von_mises(components)
