@@ -210,7 +210,7 @@ def _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, step, trial)
     """The first of ``step``, step/2, ... along -t that decreases the energy enough (None if none does).
 
     The test is on the energy along the line before the projection (phi continued below g = 0 by its
-    formula), whose slope at 0 is exactly ``slope``; the projection follows, as in Polonsky-Keer. The
+    tangent, :meth:`energy_change` of the laws), whose slope at 0 is exactly ``slope``; the projection follows, as in Polonsky-Keer. The
     change is summed from node-wise changes, so it does not cancel near the solution: the elastic part
     is the quadratic -s <S(g + h), t> + s^2/2 <t, S t>, the law's part sum (phi(g - s t) - phi(g)).
     """
