@@ -147,8 +147,9 @@ class AdhesiveContact:
 
     def energy(self, g, elastic):
         """Pi(g) (scaled, per unit area) of local arrays ``g`` and ``elastic`` = S (g + h)."""
-        h = self.problem.local(self.problem.heights, readonly=True)
-        sums = allsum(self.problem.mpi, [0.5 * np.dot((g + h).ravel(), elastic.ravel()),
+        h = self.problem.local(self.problem.heights, readonly=True).ravel()
+        e = elastic.ravel()
+        sums = allsum(self.problem.mpi, [0.5 * (np.dot(g.ravel(), e) + np.dot(h, e)),
                                          self.scaled_law.energy(g).sum()])
         return float(sums.sum() / self.problem.n)
 
@@ -182,10 +183,10 @@ class AdhesiveContact:
         else:
             current, = allsum(problem.mpi, [g.sum()])
             g += target - current / problem.n
-        start = time.perf_counter()
+        started_at = time.perf_counter()
         applications = problem.operator.applications
         outcome = gap_cg(self, target) if self.tao_solver is None else self.tao_solver.solve(target)
-        return self._result(outcome, target, start, applications)
+        return self._result(outcome, target, started_at, applications)
 
     def _result(self, outcome, target, start, applications):
         problem = self.problem

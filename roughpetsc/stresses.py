@@ -60,14 +60,6 @@ class PeriodicTransfer:
             yield name
 
 
-def transfer_functions(k0, k1, depth, nu):
-    """The six transfer functions of (3.26) at ``depth``: a dict of complex arrays keyed by :data:`COMPONENTS`."""
-    transfer = PeriodicTransfer(k0, k1, nu)
-    ones = np.ones(transfer.two_pi_k.shape, dtype=complex)
-    out = np.empty_like(ones)
-    return {name: out.copy() for name in transfer.apply(ones, depth, out)}
-
-
 def uniform_state(mean_pressure, nu):
     """Stresses of a uniform pressure over the whole surface: uniaxial strain."""
     lateral = -nu / (1.0 - nu) * mean_pressure

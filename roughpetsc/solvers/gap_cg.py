@@ -198,7 +198,7 @@ def _feasible(mpi, t, g, r, scratch, open_count):
     projected iterate.
     """
     np.greater(t, 0.0, out=scratch.mask)
-    np.logical_and(scratch.mask, ~scratch.open, out=scratch.mask)
+    np.copyto(scratch.mask, False, where=scratch.open)
     np.copyto(t, 0.0, where=scratch.mask)
     total, = allsum(mpi, [t.sum()])
     np.subtract(t, total / open_count, out=t, where=scratch.open)
