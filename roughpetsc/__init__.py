@@ -57,6 +57,7 @@ _EXPORTS = {
     "isotropic_mean": ("spectra", "isotropic_mean"),
     "bandwidth": ("spectra", "bandwidth"),
     "pressure_surface": ("spectra", "pressure_surface"),
+    "heights_from_pressure_surface": ("spectra", "heights_from_pressure_surface"),
     "fractal_closed_forms": ("spectra", "fractal_closed_forms"),
     "surface_moments": ("surface_moments", "surface_moments"),
     # the contact problem (3.41)-(3.44), its solvers and their results

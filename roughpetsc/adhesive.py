@@ -158,7 +158,9 @@ class AdhesiveContact:
         """Solve at the mean gap ``gbar`` (length units) from the last solution; a :class:`Result`.
 
         The first solve starts from the rigid gap max(gbar - h, 0) shifted to mean gbar; later ones from
-        the previous gap shifted by the change of gbar (both projected onto g >= 0, mean gbar).
+        the previous gap shifted by the change of gbar (both projected onto g >= 0, mean gbar). Along a
+        retraction, keep each step below the range of the law: a longer one starts the solver with the
+        whole contact opened beyond the law's reach, and the path snaps off early.
         ``start="rigid"`` or ``"uniform"`` (g = gbar everywhere, the start of Tamaas' solver) forces a
         start: the local minimum a non-convex problem reaches depends on it. A load (``pbar``,
         ``pstar``) is refused: adhesive contact is solved under displacement control.

@@ -339,6 +339,32 @@ def pressure_surface(grid, heights, e_star=1.0):
     return np.fft.irfft2(spectrum, s=grid.shape)
 
 
+def heights_from_pressure_surface(grid, complete_contact_pressure, e_star=1.0):
+    """Zero-mean heights whose complete-contact pressure is the given field: the inverse of :func:`pressure_surface`.
+
+    h = F^-1[F[p_c] / (pi E* k)] with the k = 0 mode dropped, so that ``pressure_surface(grid, h, e_star)``
+    returns ``p_c - mean(p_c)`` to round-off. Used to build a problem whose nearly complete contact has a
+    prescribed traction on its non-contact regions (the cracks of the dissertation's chapters 5-6).
+
+    Parameters
+    ----------
+    grid : roughpetsc.surfaces.Grid
+    complete_contact_pressure : ndarray, shape grid.shape [pressure]
+    e_star : float
+        Composite modulus E* (1.6) [pressure].
+
+    Returns
+    -------
+    ndarray, shape grid.shape [length]
+    """
+    k0, k1 = grid.rfft_wavenumbers()
+    symbol = np.pi * e_star * np.hypot(k0, k1)
+    symbol[0, 0] = 1.0
+    spectrum = np.fft.rfft2(complete_contact_pressure) / symbol
+    spectrum[0, 0] = 0.0
+    return np.fft.irfft2(spectrum, s=grid.shape)
+
+
 # ----------------------------------------------------------------------------
 # Everything for one surface
 # ----------------------------------------------------------------------------

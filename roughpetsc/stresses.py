@@ -214,6 +214,29 @@ def element_influence(offset_x, offset_y, dx, dy, depth, nu):
     return total
 
 
+def padded_influence(n0, n1, spacing, depth, nu):
+    """:func:`element_influence` at every offset between two nodes of an ``n0 x n1`` grid, in the wrapped
+    layout of the zero-padded ``2 n0 x 2 n1`` FFT (offset i at index i mod 2 n0; the offsets of n0 rows
+    and n1 columns, which never occur, hold 0).
+
+    Neighbouring elements share corners, so the corner terms are evaluated once on the lattice of the
+    (2 n0 + 2) x (2 n1 + 2) corner positions and each element's sum is a difference of the lattice: a
+    quarter of the transcendental functions of a sum over each element's own four corners.
+    """
+    dy, dx = spacing
+    corner_y = ((np.arange(2 * n0 + 2) - n0 - 0.5) * dy)[:, None]
+    corner_x = ((np.arange(2 * n1 + 2) - n1 - 0.5) * dx)[None, :]
+    kernels = {}
+    for name, c in _corner_terms(corner_x, corner_y, depth, nu).items():
+        # element at unwrapped offset k: corners k - 1/2 and k + 1/2, i.e. lattice k and k + 1 (k = 0 is -n0)
+        element = c[1:, 1:] - c[1:, :-1] - c[:-1, 1:] + c[:-1, :-1]
+        element = np.roll(element[1:, 1:], (-(n0 - 1), -(n1 - 1)), axis=(0, 1))
+        element[n0, :] = 0.0
+        element[:, n1] = 0.0
+        kernels[name] = element
+    return kernels
+
+
 def free_stresses(pressure, spacing, depths, nu):
     """Stresses at each depth below a pressure on an isolated (non-periodic) half-space.
 
@@ -234,25 +257,31 @@ def free_stresses(pressure, spacing, depths, nu):
     ------
     DepthStresses
     """
+    import pyfftw
+
     depths = check_depths(depths)
     check_poisson(nu)
     n0, n1 = pressure.shape
-    dy, dx = spacing
-    rows = np.arange(2 * n0)
-    cols = np.arange(2 * n1)
-    offset_y = (np.where(rows <= n0, rows, rows - 2 * n0) * dy)[:, None]
-    offset_x = (np.where(cols <= n1, cols, cols - 2 * n1) * dx)[None, :]
-    padded = np.zeros((2 * n0, 2 * n1))
-    padded[:n0, :n1] = pressure
-    spectrum = np.fft.rfft2(padded)
+    # FFTW plans on the padded grid made once: one forward transform of the pressure, then per component and
+    # depth one forward of the kernel and one inverse of the product.
+    real = pyfftw.empty_aligned((2 * n0, 2 * n1), dtype="float64")
+    spectrum = pyfftw.empty_aligned((2 * n0, n1 + 1), dtype="complex128")
+    effort = planner_effort("FFTW_ESTIMATE")
+    forward = pyfftw.FFTW(real, spectrum, axes=(0, 1), flags=(effort,))
+    backward = pyfftw.FFTW(spectrum, real, axes=(0, 1), direction="FFTW_BACKWARD",
+                           flags=(effort, "FFTW_DESTROY_INPUT"))
+    real[...] = 0.0
+    real[:n0, :n1] = pressure
+    forward.execute()
+    pressure_spectrum = spectrum / real.size  # the unnormalised pair's 1 / size
     for depth in depths:
-        kernels = element_influence(offset_x, offset_y, dx, dy, depth, nu)
         components = {}
-        for name in COMPONENTS:
-            kernel = kernels[name]
-            kernel[n0, :] = 0.0  # offsets of n0 rows (n1 columns) never occur between two nodes
-            kernel[:, n1] = 0.0
-            components[name] = np.fft.irfft2(spectrum * np.fft.rfft2(kernel), s=padded.shape)[:n0, :n1]
+        for name, kernel in padded_influence(n0, n1, spacing, depth, nu).items():
+            real[...] = kernel
+            forward.execute()
+            spectrum *= pressure_spectrum
+            backward.execute()
+            components[name] = real[:n0, :n1].copy()
         equivalent = von_mises(components)
         location = np.unravel_index(int(np.argmax(equivalent)), equivalent.shape)
         yield DepthStresses(float(depth), components, equivalent, float(equivalent[location]),

@@ -22,10 +22,13 @@ rms heights), the load from numpy's pressure surface. Verdicts:
 
 Rows go to studies/output/stress/stress_grid.json after every cell (rerunning skips finished cells, so a
 killed run resumes); studies/output/stress/stress_grid.md and stress_grid.png (one heat map per N) are
-rewritten at the end and by ``--report``.
+rewritten at the end and by ``--report``. ``--shard NAME`` writes to stress_grid.NAME.json instead, so two
+processes on disjoint sizes or presets can share a 2-core machine; every run skips the cells of every file and the
+report merges them.
 """
 
 import argparse
+import glob
 import os
 import re
 import time
@@ -184,13 +187,22 @@ def main():
     parser.add_argument("--sizes", type=int, nargs="*", default=[64, 256, 1024])
     parser.add_argument("--max-time", type=float, nargs="*", default=[20.0, 60.0, 120.0])
     parser.add_argument("--presets", nargs="*", default=None)
+    parser.add_argument("--shard", default=None,
+                        help="write this run's rows to stress_grid.SHARD.json, so that two processes (disjoint "
+                             "--sizes or --presets) can share the machine; the report merges every shard")
     args, path, rows = common.start_resumable(parser, OUT, "stress_grid", "only rewrite the report from the JSON")
+    shards = sorted(glob.glob(os.path.join(OUT, "stress_grid.*.json")))
+    others = [r for shard in shards if shard != path_of(args.shard) for r in common.load_rows(shard)]
+    if args.shard:
+        others += rows
+        path = path_of(args.shard)
+        rows = common.load_rows(path)
     from petsc4py import PETSc
 
     from roughpetsc import ContactProblem
 
     presets = list(common.presets(args.presets))
-    done = {key_of(r) for r in rows}
+    done = {key_of(r) for r in rows + others}
     for n, max_time in zip(args.sizes, args.max_time) if not args.report else ():
         for kind in SURFACES:
             grid, heights = surface(kind, n)
@@ -217,7 +229,13 @@ def main():
                             common.save_rows(path, rows)
             finally:
                 problem.destroy()
-    report(rows, presets, sorted({r["N"] for r in rows}))
+    merged = list({key_of(r): r for r in others + rows}.values())
+    report(merged, presets, sorted({r["N"] for r in merged}))
+
+
+def path_of(shard):
+    """The JSON file of a shard's rows (None: the main file)."""
+    return os.path.join(OUT, f"stress_grid.{shard}.json" if shard else "stress_grid.json")
 
 
 if __name__ == "__main__":

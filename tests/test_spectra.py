@@ -310,3 +310,14 @@ def test_xu_generator_has_the_prescribed_amplitude_in_every_realisation():
     b = np.fft.rfft2(fractal(grid, 4, 32, 0.8, 2e-4, 3, generator="filter"))
     inside = expected > 0
     assert np.allclose(np.angle(a[inside] * np.conj(b[inside])), 0.0, atol=1e-9)
+
+
+def test_heights_from_pressure_surface_inverts_the_pressure_surface():
+    from roughpetsc.spectra import heights_from_pressure_surface, pressure_surface
+    from roughpetsc.surfaces import Grid
+
+    grid = Grid(32, 48, 1.0, 1.5)
+    target = np.random.default_rng(3).standard_normal(grid.shape)
+    heights = heights_from_pressure_surface(grid, target, 2.5)
+    assert abs(heights.mean()) < 1e-15
+    np.testing.assert_allclose(pressure_surface(grid, heights, 2.5), target - target.mean(), atol=1e-12)
