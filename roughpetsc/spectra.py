@@ -333,10 +333,15 @@ def pressure_surface(grid, heights, e_star=1.0):
     of the dissertation is ``-p_c``. The solver applies the same symbol
     distributed over the ranks (:meth:`roughpetsc.westergaard.Westergaard.pressure_surface`).
     """
-    k0, k1 = grid.rfft_wavenumbers()
     spectrum = np.fft.rfft2(heights)
-    spectrum *= np.pi * e_star * np.hypot(k0, k1)
+    spectrum *= complete_contact_symbol(grid, e_star)
     return np.fft.irfft2(spectrum, s=grid.shape)
+
+
+def complete_contact_symbol(grid, e_star):
+    """pi E* |k| on the ``rfft2`` layout of ``grid`` (|k| in cycles/length): complete-contact pressure over height."""
+    k0, k1 = grid.rfft_wavenumbers()
+    return np.pi * e_star * np.hypot(k0, k1)
 
 
 def heights_from_pressure_surface(grid, complete_contact_pressure, e_star=1.0):
@@ -357,8 +362,7 @@ def heights_from_pressure_surface(grid, complete_contact_pressure, e_star=1.0):
     -------
     ndarray, shape grid.shape [length]
     """
-    k0, k1 = grid.rfft_wavenumbers()
-    symbol = np.pi * e_star * np.hypot(k0, k1)
+    symbol = complete_contact_symbol(grid, e_star)
     symbol[0, 0] = 1.0
     spectrum = np.fft.rfft2(complete_contact_pressure) / symbol
     spectrum[0, 0] = 0.0

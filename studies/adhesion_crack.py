@@ -78,7 +78,7 @@ def run_case(n, sigma, ratio, steps):
     heights, peak = paraboloid_surface(grid, kappa_1, KAPPA)
     crack = AdhesiveCrack(sigma)
     volume_scale = 3 * work / (2 * math.sqrt(kappa_1 * KAPPA))
-    _, b_set, m_set, v_set = model_set(crack)
+    _, b_set, m_set, v_set = crack.solution_set()
     v_max = float(v_set[np.argmin(np.abs(b_set - B_MAX))]) * volume_scale
     p_b, b_b, m_b = crack.points["B"]
     # E, F and B lie below v_turns; the set's volume falls after F, so volume control jumps there too
@@ -105,17 +105,12 @@ def run_case(n, sigma, ratio, steps):
     return rows, pressure, length, volume_scale
 
 
-def model_set(crack, n=4001):
-    """The solution set of the penny-shaped crack: (p*, b*, m, V*) along the full-adhesion branch from E to F,
-    then the Maugis-Dugdale curve from F towards A."""
-    sigma = crack.sigma
-    p_full = np.linspace(sigma, crack.points["F"][0], n // 4)
-    b_full = np.sqrt(2 * (p_full - sigma) / 3)
-    p_md, b_md, m_md = crack.curve(n, 12.0)
-    p = np.concatenate([p_full, p_md])
-    b = np.concatenate([b_full, b_md])
-    m = np.concatenate([np.zeros_like(p_full), m_md])
-    return p, b, m, crack.volume(p, b, m)
+def nearest(p, b, solution_set, crack):
+    """(distance, index) of the state of ``solution_set`` nearest to (p*, b*), in (p* / p*_F, b* / b*_F)."""
+    p_f, b_f = crack.points["F"][:2]
+    d = np.hypot((p - solution_set[0]) / p_f, (b - solution_set[1]) / b_f)
+    i = int(np.argmin(d))
+    return d[i], i
 
 
 def turning_points(values):
@@ -126,18 +121,17 @@ def turning_points(values):
     return maxima, minima
 
 
-def compare_penny(rows, sigma, pressure, length, volume_scale, steps):
+def compare_penny(rows, sigma, pressure, length, volume_scale):
     """The figures of a penny-shaped case (module docstring)."""
     crack = AdhesiveCrack(sigma)
-    p_set, b_set, m_set, v_set = model_set(crack)
-    p_f, b_f = crack.points["F"][:2]
+    solution_set = crack.solution_set()
+    _, _, m_set, v_set = solution_set
     states = [(r["p0"] / pressure, math.sqrt(r["open_area"] / math.pi) / length,
                math.sqrt(r["cohesive_free_area"] / math.pi) / length, r["volume"] / volume_scale) for r in rows]
     distance, m_error, v_error = [], [], []
     for p, b, c, v in states:
-        d = np.hypot((p - p_set) / p_f, (b - b_set) / b_f)
-        i = int(np.argmin(d))
-        distance.append(d[i])
+        d, i = nearest(p, b, solution_set, crack)
+        distance.append(d)
         if b > 0 and m_set[i] > 0:
             m_error.append(abs(c / b - m_set[i]))
         v_error.append(abs(v - v_set[i]) / v_set[i] if v_set[i] > 0 else np.nan)
@@ -148,28 +142,27 @@ def compare_penny(rows, sigma, pressure, length, volume_scale, steps):
     return {"states": states, "converged": sum(r["converged"] for r in rows), "steps": len(rows),
             "distance": float(max(distance)), "median_distance": float(np.median(distance)),
             "m_error": float(max(m_error, default=float("nan"))), "v_error": float(np.nanmedian(v_error)),
-            "p_max": p_max, "p_F": p_f, "p_min": p_min, "p_B": crack.points["B"][0],
+            "p_max": p_max, "p_F": crack.points["F"][0], "p_min": p_min, "p_B": crack.points["B"][0],
             "hysteresis": float(max(abs(a[0] - b[0]) for a, b in zip(states, states[::-1])))}
 
 
-def compare_ellipse(rows, sigma, ratio, steps):
+def compare_ellipse(rows, sigma, ratio):
     """Distances of an elliptical crack's states to the penny-shaped model with the geometric and the mean
     curvature (section 6.4), over the stable part (b* > b*_G) of the opening path."""
     crack = AdhesiveCrack(sigma)
+    solution_set = crack.solution_set()
+    v_set = solution_set[3]
     out = {}
     for name, kappa in (("geometric", math.sqrt(ratio) * KAPPA), ("mean", (1 + ratio) / 2 * KAPPA)):
         work, pressure, length = scales(kappa)
-        p_set, b_set, _, v_set = model_set(crack)
-        p_f, b_f = crack.points["F"][:2]
         volume_scale = 3 * work / (2 * kappa)
         distance, v_error = [], []
         for r in rows[:len(rows) // 2 + 1]:
             p, b = r["p0"] / pressure, math.sqrt(r["open_area"] / math.pi) / length
             if b < crack.points["G"][1]:
                 continue
-            d = np.hypot((p - p_set) / p_f, (b - b_set) / b_f)
-            i = int(np.argmin(d))
-            distance.append(d[i])
+            d, i = nearest(p, b, solution_set, crack)
+            distance.append(d)
             v_error.append(abs(r["volume"] / volume_scale - v_set[i]) / v_set[i])
         out[name] = (max(distance), float(np.median(v_error)))
     return out
@@ -199,14 +192,14 @@ def main():
             for n in sorted(args.sizes if ratio == 1.0 else args.ellipse_sizes):
                 rows, pressure, length, volume_scale = run_case(n, sigma, ratio, args.steps)
                 if ratio == 1.0:
-                    c = compare_penny(rows, sigma, pressure, length, volume_scale, args.steps)
+                    c = compare_penny(rows, sigma, pressure, length, volume_scale)
                     penny.append([f"{sigma:g}", n, f"{c['converged']}/{c['steps']}", f"{c['distance']:.4f}",
                                   f"{c['median_distance']:.4f}", f"{c['m_error']:.3f}", f"{c['v_error']:.2%}",
                                   f"{c['p_max']:.4f}", f"{c['p_F']:.4f}", f"{c['p_min']:.4f}", f"{c['p_B']:.4f}",
                                   f"{c['hysteresis']:.4f}"])
                     print(" | ".join(map(str, penny[-1])), flush=True)
                     if n == max(args.sizes):
-                        p_set, b_set, _, _ = model_set(AdhesiveCrack(sigma))
+                        p_set, b_set, _, _ = AdhesiveCrack(sigma).solution_set()
                         axis.plot(p_set, b_set, "k-", lw=1, label="crack model (6.28)-(6.29), (6.36)")
                         half = len(c["states"]) // 2 + 1
                         axis.plot([s[0] for s in c["states"][:half]], [s[1] for s in c["states"][:half]], "o",
@@ -214,7 +207,7 @@ def main():
                         axis.plot([s[0] for s in c["states"][half:]], [s[1] for s in c["states"][half:]], "x",
                                   ms=3, label="BEM closing")
                 else:
-                    c = compare_ellipse(rows, sigma, ratio, args.steps)
+                    c = compare_ellipse(rows, sigma, ratio)
                     ellipse.append([f"{sigma:g}", f"{ratio:g}", n, f"{sum(r['converged'] for r in rows)}/{len(rows)}",
                                     f"{c['geometric'][0]:.4f}", f"{c['geometric'][1]:.2%}",
                                     f"{c['mean'][0]:.4f}", f"{c['mean'][1]:.2%}"])

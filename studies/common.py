@@ -135,6 +135,12 @@ def markdown_table(header, rows):
     return "\n".join(lines)
 
 
+def records_table(records):
+    """A markdown table of dicts with the same keys (the first one's order), floats to 4 significant digits."""
+    keys = list(records[0])
+    return markdown_table(keys, [[f"{r[k]:.4g}" if isinstance(r[k], float) else r[k] for k in keys] for r in records])
+
+
 def save_figure(fig, folder, name):
     """Lay out, write (PNG, 110 dpi) and close a matplotlib figure; returns ``name``."""
     import matplotlib.pyplot as plt

@@ -341,11 +341,7 @@ def test_penny_shaped_adhesive_crack_meets_the_maugis_dugdale_crack():
     surface = -0.5 * (r[:, None] ** 2 + r[None, :] ** 2)
     surface -= surface.mean()
     crack = AdhesiveCrack(sigma)
-    p_md, b_md, m_md = crack.curve(4001, 12.0)
-    p_full = np.linspace(sigma, crack.points["F"][0], 1000)
-    p_set = np.concatenate([p_full, p_md])
-    b_set = np.concatenate([np.sqrt(2 * (p_full - sigma) / 3), b_md])
-    v_set = crack.volume(p_set, b_set, np.concatenate([np.zeros_like(p_full), m_md]))
+    p_set, b_set, _, v_set = crack.solution_set()
     p_f, b_f = crack.points["F"][:2]
     volumes = np.concatenate([np.linspace(0.1, 12.0, 12), [20.0, 40.0, 80.0]]) * volume_scale
     states = []

@@ -113,3 +113,17 @@ def test_adhesive_gw_groups_and_limits():
     Ar, gr = M.complete("gw", p, gw.alpha_p, alpha_h)
     assert np.allclose(A0, Ar, rtol=1e-6) and np.allclose(g0, gr, rtol=1e-5)
     assert np.all(A > Ar) and np.all(g < gr)
+
+
+def test_solution_set_runs_from_E_through_F():
+    """The set starts at E (p* = sigma0*, b* = 0, (6.38)); its two branches meet at F ((6.39): p*_F =
+    sigma0* + 3/2 sigma0*^(-2/3), b*_F = sigma0*^(-1/3), m = 0), and m rises from there."""
+    sigma = 2.0
+    p, b, m, v = M.AdhesiveCrack(sigma).solution_set(401)
+    assert p[0] == sigma and b[0] == 0 and v[0] == 0
+    joint = 401 // 4
+    for i in (joint - 1, joint):
+        assert p[i] == pytest.approx(sigma + 1.5 * sigma ** (-2 / 3), rel=1e-12)
+        assert b[i] == pytest.approx(sigma ** (-1 / 3), rel=1e-12)
+        assert m[i] == 0
+    assert np.all(np.diff(m[joint:]) > 0)

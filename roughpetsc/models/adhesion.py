@@ -169,6 +169,19 @@ class AdhesiveCrack:
         q = np.linspace(0.0, q_max, n)
         return self.p_of_q(q), self.b_of_q(q), self.m_of_q(q)
 
+    def solution_set(self, n=4001, q_max=12.0):
+        """Every equilibrium state, as arrays (p*, b*, m, V*): the full-adhesion branch (6.36) from E
+        (p* = sigma0*, (6.38)) to F, then the Maugis-Dugdale curve (:meth:`curve`) from F towards A.
+
+        The set a path under volume (mean-gap) control visits; ``n // 4`` states on the first branch,
+        ``n`` on the second."""
+        p_full = np.linspace(self.sigma, self.points["F"][0], n // 4)
+        p_md, b_md, m_md = self.curve(n, q_max)
+        p = np.concatenate([p_full, p_md])
+        b = np.concatenate([nonadhesive_radius(p_full - self.sigma), b_md])
+        m = np.concatenate([np.zeros_like(p_full), m_md])
+        return p, b, m, self.volume(p, b, m)
+
     # equilibrium quantities -----------------------------------------------------
     def stable(self, p):
         """(b*, m) on the stable Maugis-Dugdale branch at p* >= p*_B (NaN below)."""

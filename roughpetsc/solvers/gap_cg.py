@@ -16,7 +16,8 @@ as the unknown and the mean gap as the constraint, with three changes of ours:
 
 After each step the gap is projected onto {g >= 0, mean g = gbar} exactly (a shift of the positive
 nodes found by Newton's method on a piecewise-linear function). Every stop is decided on a freshly
-computed S g; a stop short of the tolerance returns the iterate of the lowest residual.
+computed S g; a stop short of the tolerance returns an iterate whose residual is within a factor 2 of the
+lowest it saw (a copy is kept each time the residual halves, not at every iteration).
 """
 
 import numpy as np
@@ -72,7 +73,7 @@ class _Scratch:
         self.free = np.empty(size)
         self.open = np.empty(size, dtype=bool)
         self.mask = np.empty(size, dtype=bool)
-        self.best = np.empty(size)  # the iterate of the lowest natural residual, returned by a stop short of it
+        self.best = np.empty(size)  # an iterate near the lowest natural residual, returned by a stop short of it
 
 
 def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, previous_vec):
@@ -92,7 +93,7 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
     project_mean(mpi, g, target, n)
     history = History(problem)
     rz_old, fresh_needed, since_fresh = 1.0, True, 0
-    best, best_iteration, stopped_by = np.inf, 0, None
+    best, best_iteration, saved, stopped_by = np.inf, 0, np.inf, None
     iteration, reason = 0, "DIVERGED_MAXITS"
     while True:
         if fresh_needed or since_fresh >= REFRESH:
@@ -110,7 +111,9 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
             break
         if natural < best:
             best, best_iteration = natural, iteration
-            np.copyto(scratch.best, g)
+            if natural <= 0.5 * saved:  # an N^2 copy per halving of the residual, not per iteration
+                saved = natural
+                np.copyto(scratch.best, g)
         if iteration >= adhesive.max_iter:
             break
         if history.out_of_time(adhesive.max_seconds):
@@ -166,8 +169,10 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
         iteration += 1
     notes = [stopped_by] if stopped_by else []
     if not reason.startswith("CONVERGED") and np.isfinite(best):
-        np.copyto(g, scratch.best)  # the caller certifies it afresh
-        notes.append(f"best natural residual {best:.2g}")
+        if natural > saved:  # natural: the residual of the last iterate, the one g holds
+            np.copyto(g, scratch.best)  # the caller certifies it afresh
+            natural = saved
+        notes.append(f"best natural residual {natural:.2g}")
     return Outcome(separation=target, iterations=iteration,
                    reason=f"{reason} ({', '.join(notes)})" if notes else reason, history=history.as_array())
 
@@ -210,9 +215,10 @@ def _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, step, trial)
     """The first of ``step``, step/2, ... along -t that decreases the energy enough (None if none does).
 
     The test is on the energy along the line before the projection (phi continued below g = 0 by its
-    tangent, :meth:`energy_change` of the laws), whose slope at 0 is exactly ``slope``; the projection follows, as in Polonsky-Keer. The
-    change is summed from node-wise changes, so it does not cancel near the solution: the elastic part
-    is the quadratic -s <S(g + h), t> + s^2/2 <t, S t>, the law's part sum (phi(g - s t) - phi(g)).
+    tangent, :meth:`energy_change` of the laws), whose slope at 0 is exactly ``slope``; the projection
+    follows, as in Polonsky-Keer. The change is summed from node-wise changes, so it does not cancel near
+    the solution: the elastic part is the quadratic -s <S(g + h), t> + s^2/2 <t, S t>, the law's part
+    sum (phi(g - s t) - phi(g)).
     """
     law, mpi = adhesive.scaled_law, adhesive.problem.mpi
     elastic_slope, = allsum(mpi, [np.dot(elastic, t)])
