@@ -330,10 +330,11 @@ def record_stresses(settings, record, grid, fields):
         raise UserError("-stress_depths: the last step's pressure field is not available (all steps taken from a "
                         "file without fields)")
     if settings.boundary == "periodic":
-        depths = periodic_stresses(pressure, (grid.l0, grid.l1), settings.stress_depths, settings.nu)
+        depths = periodic_stresses(pressure, (grid.l0, grid.l1), settings.stress_depths, settings.nu,
+                                   settings.fft_effort)
     else:
         depths = free_stresses(pressure, (grid.l0 / grid.n0, grid.l1 / grid.n1), settings.stress_depths,
-                               settings.nu)
+                               settings.nu, settings.fft_effort)
     record.stresses = list(depths)
     for depth in record.stresses:
         print(f"  stresses at depth {depth.depth:.4g}: max von Mises {depth.max_von_mises:.4g} at node "

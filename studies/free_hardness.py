@@ -16,7 +16,8 @@ Writes studies/output/free_hardness/free_hardness.md and free_hardness.png:
 5. Costs, as ratios of times measured in one run (the machine is shared; medians of --repeat):
    free / periodic solve at the same N (target <= 4.5), capped / uncapped solve (target <= 1.2, a
    group-#1 surface at p* = 0.5 with H at the 95th percentile of the uncapped pressure), and the
-   stresses at 8 depths per depth in operator applications (target <= 3 each).
+   stresses at 8 depths per depth in operator applications (target <= 3 each), beside their floor: the
+   bare FFTs a depth needs (six inverse transforms periodic, twelve padded ones free).
 """
 
 import argparse
@@ -149,29 +150,65 @@ def costs(n, repeat):
 
     _, uncapped, _ = solve()
     hardness = float(np.quantile(uncapped[uncapped > 0], 0.95))
-    periodic_s = median_seconds(lambda: solve()[0], repeat)
-    free_s = median_seconds(lambda: solve("free")[0], repeat)
-    capped_s = median_seconds(lambda: solve(hardness=hardness)[0], repeat)
-    capped_result = solve(hardness=hardness)[2]
-    problem = ContactProblem(grid, heights, 1.0)
-    try:
-        x = problem.vec()
-        y = problem.vec()
-        application = median_seconds(lambda: _timed(problem.operator.displacement, x, y), max(repeat, 5))
-        x.destroy()
-        y.destroy()
-    finally:
-        problem.destroy()
+    # Interleaved repeats, so that a change in the machine's load falls on every kind of solve alike.
+    seconds = {"periodic": [], "free": [], "capped": []}
+    for _ in range(repeat):
+        seconds["periodic"].append(solve()[0])
+        seconds["free"].append(solve("free")[0])
+        capped_seconds, _, capped_result = solve(hardness=hardness)
+        seconds["capped"].append(capped_seconds)
+    periodic_s, free_s, capped_s = (statistics.median(seconds[kind]) for kind in ("periodic", "free", "capped"))
+    application = {boundary: operator_seconds(grid, heights, boundary, max(repeat, 5))
+                   for boundary in ("periodic", "free")}
     depths = np.linspace(0.0, 0.1, 8)
     periodic_depth = median_seconds(lambda: _timed_list(periodic_stresses(uncapped, (1.0, 1.0), depths, NU)),
                                     repeat) / len(depths)
     free_depth = median_seconds(lambda: _timed_list(free_stresses(uncapped, (1 / n, 1 / n), depths, NU)),
                                 repeat) / len(depths)
+    periodic_floor, free_floor = (transform_floor(shape, count, repeat)
+                                  for shape, count in (((n, n), (0, 6)), ((2 * n, 2 * n), (6, 6))))
     return {"N": n, "free/periodic": free_s / periodic_s, "capped/uncapped": capped_s / periodic_s,
             "A_plastic": capped_result.A_plastic, "capped reason": capped_result.reason,
-            "periodic stresses per depth / application": periodic_depth / application,
-            "free stresses per depth / application": free_depth / application,
+            "periodic stresses per depth / application": periodic_depth / application["periodic"],
+            "their floor, six inverse transforms / application": periodic_floor / application["periodic"],
+            "free stresses per depth / free application": free_depth / application["free"],
+            "their floor, twelve padded transforms / free application": free_floor / application["free"],
+            "free stresses per depth / periodic application": free_depth / application["periodic"],
             "periodic solve s": periodic_s}
+
+
+def operator_seconds(grid, heights, boundary, repeat):
+    """Median seconds of one application of the operator (K p) of ``boundary``."""
+    from roughpetsc import ContactProblem
+
+    problem = ContactProblem(grid, heights, 1.0, boundary=boundary)
+    x, y = problem.vec(), problem.vec()
+    try:
+        return median_seconds(lambda: _timed(problem.operator.displacement, x, y), repeat)
+    finally:
+        x.destroy()
+        y.destroy()
+        problem.destroy()
+
+
+def transform_floor(shape, counts, repeat):
+    """Median seconds of ``counts = (forward, inverse)`` bare transforms on ``shape``: what the stresses of
+    one depth cannot do without (the FFTW plans of :mod:`roughpetsc.stresses`, from the solves' wisdom)."""
+    from roughpetsc.stresses import _plans
+
+    real, spectrum, forward, backward = _plans(shape, "FFTW_MEASURE")
+    real[...] = 1.0
+    spectrum[...] = 1.0  # the inverse destroys it, into values of the same size: no refill in the timing
+
+    def run():
+        start = time.perf_counter()
+        for _ in range(counts[0]):
+            forward.execute()
+        for _ in range(counts[1]):
+            backward.execute()
+        return time.perf_counter() - start
+
+    return median_seconds(run, repeat)
 
 
 def _timed(function, *args):

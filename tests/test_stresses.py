@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from roughpetsc.errors import ParameterError
-from roughpetsc.stresses import element_influence, free_stresses, max_shear, periodic_stresses
+from roughpetsc.stresses import (element_influence, free_stresses, max_shear, padded_influence, periodic_stresses,
+                                 von_mises)
 
 
 def rotated_plane_strain(amplitude, wavenumber, direction, depth, nu, phase):
@@ -57,6 +58,17 @@ def test_max_shear_of_a_diagonal_state():
     assert max_shear(s)[0] == pytest.approx(1.4)
 
 
+def test_von_mises_from_the_principal_stresses():
+    """The blocked ufunc form against sqrt(((s1 - s2)^2 + (s2 - s3)^2 + (s3 - s1)^2) / 2) of the eigenvalues."""
+    rng = np.random.default_rng(3)
+    s = {name: rng.standard_normal((70, 5)) for name in ("xx", "yy", "zz", "xy", "yz", "xz")}
+    tensor = np.stack([np.stack([s["xx"], s["xy"], s["xz"]], -1), np.stack([s["xy"], s["yy"], s["yz"]], -1),
+                       np.stack([s["xz"], s["yz"], s["zz"]], -1)], -2)
+    s1, s2, s3 = np.moveaxis(np.linalg.eigvalsh(tensor), -1, 0)
+    expected = np.sqrt(((s1 - s2) ** 2 + (s2 - s3) ** 2 + (s3 - s1) ** 2) / 2)
+    assert np.abs(von_mises(s, block_rows=16) - expected).max() < 1e-12 * expected.max()
+
+
 @pytest.mark.parametrize("depths, nu, parameter", [([-1.0], 0.3, "depths"), ([], 0.3, "depths"),
                                                    ([0.1], 0.5, "nu")])
 def test_bad_parameters_are_named(depths, nu, parameter):
@@ -87,6 +99,22 @@ def test_element_influence_integrates_the_point_load(offset):
         quadrature = dblquad(lambda b, a: boussinesq_point_load(X - a, Y - b, z, nu)[name],
                              -0.5, 0.5, -0.4, 0.4, epsabs=1e-14, epsrel=1e-12)[0]
         assert abs(float(value) - quadrature) < 1e-12, name
+
+
+@pytest.mark.parametrize("depth", [0.0, 0.35])
+def test_padded_influence_is_the_element_influence_at_every_wrapped_offset(depth):
+    """The quadrant-and-parity construction against the four-corner sum of each offset on its own."""
+    n0, n1, spacing, nu = 5, 4, (0.7, 0.4), 0.3
+    rows = np.arange(2 * n0)
+    cols = np.arange(2 * n1)
+    offset_y = np.where(rows < n0, rows, rows - 2 * n0)[:, None] * spacing[0]
+    offset_x = np.where(cols < n1, cols, cols - 2 * n1)[None, :] * spacing[1]
+    direct = element_influence(offset_x, offset_y, spacing[1], spacing[0], depth, nu)
+    for name, kernel in padded_influence(n0, n1, spacing, depth, nu):
+        expected = direct[name].copy()
+        expected[n0, :] = 0.0  # offsets that never occur between two nodes
+        expected[:, n1] = 0.0
+        assert np.abs(kernel - expected).max() <= 1e-14 * np.abs(expected).max(), name
 
 
 def hertz_pressure(n, nodes_per_radius):

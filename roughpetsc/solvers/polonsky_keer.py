@@ -180,8 +180,10 @@ class PolonskyKeer:
             fresh = since_fresh == 0
             np.greater(p, 0.0, out=contact)
             if upper is not None:
+                # Plastic nodes (their gap may be negative) leave the contact set: arithmetic on the masks,
+                # as a copy under a mask (np.copyto with where=) costs several passes.
                 np.greater_equal(p, upper, out=at_cap)
-                np.copyto(contact, 0.0, where=at_cap)  # plastic nodes: their gap may be negative
+                contact -= at_cap
             np.subtract(displacement, h, out=gap)
             if load_control:
                 # d is fixed by a zero mean gap on the (elastic) contact set: g = K p - h + d.
@@ -189,7 +191,7 @@ class PolonskyKeer:
                 if count:  # (a fully plastic contact keeps the last d)
                     self.separation = -gap_sum / count
             gap += self.separation
-            kkt = report(mpi, p, gap, n, pbar, upper)
+            kkt = report(mpi, p, gap, n, pbar, upper, scratch=(z, response), feasibility=False)  # both spent here
             converged = kkt.natural <= self.rtol and (kkt.load_error is None or kkt.load_error <= self.rtol)
             if converged and not fresh and self.confirm:
                 fresh_needed = True  # confirm on a freshly computed K p before stopping
@@ -221,7 +223,7 @@ class PolonskyKeer:
                 # Plastic nodes whose gap opens leave the cap: they join the free set.
                 np.greater(gap, 0.0, out=opening)
                 opening &= at_cap
-                np.copyto(contact, 1.0, where=opening)
+                contact += opening  # 0.0 before: they are at the cap
             if bccg or not load_control:
                 count, gap_sum = allsum(mpi, [contact.sum(), np.dot(gap, contact)])
             else:
@@ -251,6 +253,11 @@ class PolonskyKeer:
             t *= beta
             t += direction
             rz_old = rz
+            if load_control and upper is not None:
+                # t at zero sum keeps the load, which beside capped nodes only a fresh K p could restore.
+                t_sum, = allsum(mpi, [t.sum()])
+                np.multiply(contact, t_sum / count, out=response)
+                t -= response
             operator.displacement(direction_vec, response_vec)
             q_sum, t_sum, numerator, q_dot_t = allsum(mpi, [np.dot(response, contact), t.sum(), np.dot(gap, t),
                                                              np.dot(response, t)])
@@ -269,7 +276,7 @@ class PolonskyKeer:
             clipped = np.count_nonzero(np.less(p, 0.0, out=negative))
             np.maximum(p, 0.0, out=p)
             if upper is not None:
-                clipped += np.count_nonzero(p > upper)
+                clipped += np.count_nonzero(np.greater(p, upper, out=negative))
                 np.minimum(p, upper, out=p)
             if bccg:
                 changed, = allsum(mpi, [clipped])
@@ -335,21 +342,23 @@ class PolonskyKeer:
         mpi = self.problem.mpi
         stale = False
         for _ in range(8):
-            capped = p >= upper
-            n_capped, free_load = allsum(mpi, [np.count_nonzero(capped), p.sum(where=~capped)])
+            # Capped nodes hold p = upper exactly (the projection sets them so): the free load is the rest.
+            capped = np.flatnonzero(p >= upper)
+            n_capped, total = allsum(mpi, [capped.size, p.sum()])
             wanted = total_load - upper * n_capped
             if wanted <= 0:
                 # The capped nodes alone carry more than the load: scale every node down, off the cap.
-                total, = allsum(mpi, [p.sum()])
                 p *= total_load / total
                 return True
+            free_load = total - upper * n_capped
             if not free_load > 0:
                 # Every loaded node is capped and the load wants more: only a larger contact can carry
                 # it, which rescaling cannot make (the caller stops; see CappedPKLoad).
                 self.stopped_by = "the cap carries the whole load"
                 return True
             scale = wanted / free_load
-            np.multiply(p, scale, out=p, where=~capped)
+            p *= scale
+            p[capped] = upper
             if n_capped or stale:
                 stale = True
             else:
