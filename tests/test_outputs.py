@@ -98,7 +98,10 @@ def test_ctrl_c_keeps_the_finished_steps_and_resume_completes_the_path(tmp_path)
     output = tmp_path / "i.h5"
     command = [sys.executable, "-m", "roughpetsc", *map(str, args), "-output", str(output)]
     env = dict(os.environ, **MPI_ENV, PYTHONPATH=ROOT)
-    run = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env)
+    # A suite started in the background of a non-interactive shell inherits SIGINT ignored, and Python
+    # then keeps ignoring it: the child gets Ctrl-C's default back, as a command typed at a terminal has it.
+    run = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env,
+                           preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     while not output.exists() and run.poll() is None:  # the first step is saved
         time.sleep(0.01)
     run.send_signal(signal.SIGINT)
