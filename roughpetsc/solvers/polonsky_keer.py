@@ -224,7 +224,7 @@ class PolonskyKeer:
                 np.greater(gap, 0.0, out=opening)
                 opening &= at_cap
                 contact += opening  # 0.0 before: they are at the cap
-            if bccg or not load_control:
+            if bccg or not load_control or upper is not None:  # (opening nodes may have joined the free set)
                 count, gap_sum = allsum(mpi, [contact.sum(), np.dot(gap, contact)])
             else:
                 gap_sum = 0.0  # the free set is the contact set, where d has made the mean gap zero
@@ -253,7 +253,7 @@ class PolonskyKeer:
             t *= beta
             t += direction
             rz_old = rz
-            if load_control and upper is not None:
+            if load_control and upper is not None and count:
                 # t at zero sum keeps the load, which beside capped nodes only a fresh K p could restore.
                 t_sum, = allsum(mpi, [t.sum()])
                 np.multiply(contact, t_sum / count, out=response)
