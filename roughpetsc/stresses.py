@@ -135,7 +135,7 @@ def check_poisson(nu):
         raise ParameterError("nu", f"Poisson's ratio must lie in (-1, 0.5), got {nu}")
 
 
-def _plans(shape, effort):
+def fft_pair(shape, effort):
     """FFTW plans ``real -> spectrum`` and back on aligned arrays of ``shape`` (the backward destroys its input).
 
     Plans of the operator's shape and effort are already in FFTW's wisdom after a solve, so these cost
@@ -199,7 +199,7 @@ def periodic_stresses(pressure, lengths, depths, nu, effort="FFTW_MEASURE"):
     depths = check_depths(depths)
     check_poisson(nu)
     n0, n1 = pressure.shape
-    real, spectrum, forward, backward = _plans((n0, n1), effort)
+    real, spectrum, forward, backward = fft_pair((n0, n1), effort)
     real[...] = pressure
     forward.execute()
     pressure_spectrum = spectrum / (n0 * n1)  # the unnormalised pair's 1 / (n0 n1)
@@ -330,7 +330,7 @@ def free_stresses(pressure, spacing, depths, nu, effort="FFTW_MEASURE"):
     depths = check_depths(depths)
     check_poisson(nu)
     n0, n1 = pressure.shape
-    real, spectrum, forward, backward = _plans((2 * n0, 2 * n1), effort)
+    real, spectrum, forward, backward = fft_pair((2 * n0, 2 * n1), effort)
     real[...] = 0.0
     real[:n0, :n1] = pressure
     forward.execute()

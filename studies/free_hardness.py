@@ -194,9 +194,9 @@ def operator_seconds(grid, heights, boundary, repeat):
 def transform_floor(shape, counts, repeat):
     """Median seconds of ``counts = (forward, inverse)`` bare transforms on ``shape``: what the stresses of
     one depth cannot do without (the FFTW plans of :mod:`roughpetsc.stresses`, from the solves' wisdom)."""
-    from roughpetsc.stresses import _plans
+    from roughpetsc.stresses import fft_pair
 
-    real, spectrum, forward, backward = _plans(shape, "FFTW_MEASURE")
+    real, spectrum, forward, backward = fft_pair(shape, "FFTW_MEASURE")
     real[...] = 1.0
     spectrum[...] = 1.0  # the inverse destroys it, into values of the same size: no refill in the timing
 
