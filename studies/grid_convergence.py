@@ -14,7 +14,9 @@ For every (group, seed, p*) the observed order of convergence is p = log2((A_{N/
 A_N)) over the three finest grids, and the Richardson value A_N + (A_N - A_{N/2}) / (2^p - 1) with the
 error bar |A_N - A_{N/2}| / (2^p - 1); where the differences do not shrink monotonically the order is
 not defined and is reported as such. Rows go to studies/output/grid_convergence/grid_convergence.json
-after every solve (a killed run resumes); ``--report`` writes grid_convergence.md and .png.
+after every solve (a killed run resumes); ``--report`` writes grid_convergence.md and .png. Under
+``mpiexec -n 2`` each grid is split over the ranks (8192^2 fits this machine only so) and rank 0 writes
+the rows.
 """
 
 import argparse
@@ -64,8 +66,11 @@ def save_rows(rows):
 
 
 def run(args):
+    from petsc4py import PETSc
+
     from roughpetsc import ContactProblem, Grid, fractal_group, load_path
 
+    root = PETSc.COMM_WORLD.getRank() == 0  # under mpiexec every rank solves its rows; rank 0 keeps the file
     rows = load_rows()
     done = {(r["group"], r["seed"], r["N"], r["pstar"]) for r in rows}
     n_coarse = min(args.sizes)
@@ -85,12 +90,14 @@ def run(args):
                                  "A_corrected": result.A_corrected, "gstar": result.gstar,
                                  "natural": result.kkt.natural, "converged": result.converged,
                                  "reason": result.reason, "time_s": result.time_s})
-                    save_rows(rows)
-                    print(f"group {number} seed {seed} N {n} p* {pstar}: A {result.A:.5f} corrected "
-                          f"{result.A_corrected:.5f} g* {result.gstar:.5f} ({result.time_s:.1f} s, "
-                          f"{result.reason})", flush=True)
+                    if root:
+                        save_rows(rows)
+                        print(f"group {number} seed {seed} N {n} p* {pstar}: A {result.A:.5f} corrected "
+                              f"{result.A_corrected:.5f} g* {result.gstar:.5f} ({result.time_s:.1f} s, "
+                              f"{result.reason})", flush=True)
                 problem.destroy()
-                print(f"  N {n}: {time.perf_counter() - start:.0f} s", flush=True)
+                if root:
+                    print(f"  N {n}: {time.perf_counter() - start:.0f} s", flush=True)
 
 
 def richardson(sizes, values):
@@ -156,7 +163,10 @@ def main():
     common.init()
     if not args.report:
         run(args)
-    report()
+    from petsc4py import PETSc
+
+    if PETSc.COMM_WORLD.getRank() == 0:
+        report()
 
 
 if __name__ == "__main__":
