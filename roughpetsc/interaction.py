@@ -55,13 +55,29 @@ class Dugdale:
 
     def energy_change(self, gap, trial):
         """``phi(trial) - phi(gap)`` node by node, as sigma0 (min(trial, h0) - min(gap, h0)) (no w to cancel)."""
-        return self.stress * (np.minimum(trial, self.range) - np.minimum(gap, self.range))
+        return self.energy_changes_from(gap)(trial, np.empty_like(trial))
+
+    def energy_changes_from(self, gap):
+        """``change(trial, out)``: :meth:`energy_change` from ``gap`` written to ``out`` (which may be ``trial``),
+        the part of ``gap`` made once (a line search calls it for every trial step)."""
+        base = np.minimum(gap, self.range)
+
+        def change(trial, out):
+            np.minimum(trial, self.range, out=out)
+            out -= base
+            out *= self.stress
+            return out
+
+        return change
 
     def force(self, gap, out=None):
         return np.multiply(np.less(gap, self.range), self.stress, out=out)
 
-    def curvature(self, gap):
-        return np.zeros_like(gap)
+    def curvature(self, gap, out=None):
+        if out is None:
+            return np.zeros_like(gap)
+        out[...] = 0.0
+        return out
 
     def describe(self):
         return f"Dugdale law: w = {self.work:.6g}, sigma0 = {self.stress:.6g}, range h0 = {self.range:.6g}"
@@ -93,8 +109,26 @@ class Exponential:
         Below g = 0 (a line search's trial before its projection) phi is continued by its tangent at 0,
         as the Dugdale law continues itself, so that a long step cannot gain unbounded energy.
         """
-        above = np.maximum(trial, 0.0)
-        return self.energy(gap) * np.expm1((gap - above) / self.range) + self.peak_stress * (trial - above)
+        return self.energy_changes_from(gap)(trial, np.empty_like(trial))
+
+    def energy_changes_from(self, gap):
+        """``change(trial, out)``: :meth:`energy_change` from ``gap`` written to ``out`` (which may be ``trial``),
+        phi(gap) made once (a line search calls it for every trial step); one scratch array is kept."""
+        base = self.energy(gap)
+        above = np.empty_like(gap)
+
+        def change(trial, out):  # out may be trial
+            np.maximum(trial, 0.0, out=above)
+            np.subtract(trial, above, out=out)  # the part of the trial below 0, on phi's tangent there
+            out *= self.peak_stress
+            np.subtract(gap, above, out=above)
+            np.multiply(above, 1.0 / self.range, out=above)
+            np.expm1(above, out=above)
+            np.multiply(above, base, out=above)
+            out += above
+            return out
+
+        return change
 
     def force(self, gap, out=None):
         out = np.divide(gap, -self.range, out=out)
@@ -102,8 +136,11 @@ class Exponential:
         out *= self.peak_stress
         return out
 
-    def curvature(self, gap):
-        return -self.peak_stress / self.range * np.exp(-gap / self.range)
+    def curvature(self, gap, out=None):
+        out = np.multiply(gap, -1.0 / self.range, out=out)
+        np.exp(out, out=out)
+        out *= -self.peak_stress / self.range
+        return out
 
     def describe(self):
         return (f"exponential law: w = {self.work:.6g}, range rho = {self.range:.6g}, "

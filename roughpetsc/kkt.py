@@ -134,6 +134,7 @@ class History:
 
     def __init__(self, problem):
         self.operator = problem.operator
+        self.mpi = problem.mpi
         self.progress = problem.progress
         self.start = time.perf_counter()
         self.rows = []
@@ -145,8 +146,14 @@ class History:
             self.progress(iteration, natural, seconds)
 
     def out_of_time(self, max_seconds):
-        """True when ``max_seconds`` (> 0) have passed since the history started (``-solve_max_time``)."""
-        return max_seconds > 0 and time.perf_counter() - self.start > max_seconds
+        """True when ``max_seconds`` (> 0) have passed since the history started (``-solve_max_time``).
+
+        Collective when ``max_seconds > 0``: rank 0's clock decides for every rank, as ranks whose clocks
+        disagreed at the limit would leave the solve by different iterations and hang.
+        """
+        if not max_seconds > 0:
+            return False
+        return self.mpi.bcast(time.perf_counter() - self.start > max_seconds, root=0)
 
     def as_array(self):
         return np.array(self.rows, dtype=np.float64).reshape(-1, 4)

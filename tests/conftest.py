@@ -31,3 +31,23 @@ def run_cli(args, ranks=1, cwd=None, timeout=600):
     env = dict(os.environ, **MPI_ENV)
     env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
     return subprocess.run(command, capture_output=True, text=True, cwd=cwd or ROOT, env=env, timeout=timeout)
+
+
+def applications_at_time_limit(monkeypatch, problem):
+    """A list that receives ``problem``'s operator applications when a solve first finds its time limit passed.
+
+    ``problem.operator.applications`` minus its one entry is then the work done after the limit.
+    """
+    from roughpetsc import kkt
+
+    at_limit = []
+    out_of_time = kkt.History.out_of_time
+
+    def recorded(history, max_seconds):
+        expired = out_of_time(history, max_seconds)
+        if expired and not at_limit:
+            at_limit.append(problem.operator.applications)
+        return expired
+
+    monkeypatch.setattr(kkt.History, "out_of_time", recorded)
+    return at_limit

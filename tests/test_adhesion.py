@@ -18,7 +18,7 @@ import pytest
 
 import h5py
 
-from conftest import MPI_ENV, ROOT, run_cli
+from conftest import MPI_ENV, ROOT, applications_at_time_limit, run_cli
 from roughpetsc.adhesive import AdhesiveContact, approach_retraction, dissipated_energy
 from roughpetsc.contact import ContactProblem
 from roughpetsc.errors import ParameterError
@@ -384,3 +384,18 @@ def test_dugdale_wave_tends_to_johnsons_jkr_wave():
     snap_off = max(r.gbar for r in results[steps:] if r.A > 0)
     step = 2.15 * amplitude / steps
     assert abs(snap_off - jkr_pulloff_displacement_control(1.0, amplitude, 1.0, work)[2]) < 0.02 * amplitude + step
+
+
+def test_tao_almm_stops_within_a_line_search_of_its_time_limit(monkeypatch):
+    """The time limit ends ALMM's subsolve (a zero gradient left the augmented Lagrangian's constraint term)."""
+    grid = Grid(256, 256, 1.0, 1.0)
+    problem = ContactProblem(grid, fractal(grid, 4, 64, 0.8, 1e-2, seed=4), 1.0, fft_effort="FFTW_ESTIMATE")
+    at_limit = applications_at_time_limit(monkeypatch, problem)
+    adhesive = AdhesiveContact(problem, Exponential(5e-6, 1e-3), rtol=1e-13, max_seconds=0.3, solver="almm")
+    try:
+        result = adhesive.solve(8e-3)
+        assert not result.converged and "time limit" in result.reason, result.reason
+        assert at_limit and problem.operator.applications - at_limit[0] <= 40  # one line search's evaluations
+    finally:
+        adhesive.destroy()
+        problem.destroy()

@@ -8,6 +8,8 @@ from roughpetsc.contact import ContactProblem
 from roughpetsc.control import Solver
 from roughpetsc.surfaces import Grid, fractal
 
+from conftest import applications_at_time_limit
+
 TYPES = ["blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bnls", "bntr", "tron", "gpcg"]
 
 
@@ -111,3 +113,22 @@ def test_root_find_meets_the_load_near_complete_contact(tao_type):
     finally:
         solver.destroy()
         problem.destroy()
+
+
+def test_almm_stops_within_a_line_search_of_its_time_limit(monkeypatch):
+    """ALMM's time limit ends its subsolve (a zero gradient did not: the augmented Lagrangian keeps the
+    constraint term, and a 1024^2 solve ran 994 operator applications, 100 s, past a 10 s limit)."""
+    grid = Grid(256, 256)
+    problem = ContactProblem(grid, fractal(grid, 16, 64, 0.8, 2e-4, 5), 1.0, PETSc.COMM_SELF,
+                             fft_effort="FFTW_ESTIMATE")
+    at_limit = applications_at_time_limit(monkeypatch, problem)
+    PETSc.Options().setValue("solve_max_time", 0.5)
+    solver = Solver(problem, "load", "almm", 1e-12)
+    try:
+        result = solver.solve(pstar=0.98 * problem.complete_contact_pbar * problem.pressure_scale / problem.sqrt_m0p)
+        assert not result.converged and "time limit" in result.reason
+        assert at_limit and problem.operator.applications - at_limit[0] <= 40  # one line search's evaluations
+    finally:
+        solver.destroy()
+        problem.destroy()
+        PETSc.Options().delValue("solve_max_time")

@@ -17,7 +17,7 @@ from petsc4py import PETSc
 from ..kkt import STAGNATION_ITERATIONS, History, allsum
 from .almm import mean_jacobian
 from .protocol import Outcome, reason_name
-from .tao_options import DEFAULT_MAX_IT, default_options, set_from_options
+from .tao_options import DEFAULT_MAX_IT, default_options, set_from_options, stop_subsolver
 
 DEFAULTS = {"tao_almm_type": "phr", "tao_almm_subsolver_tao_type": "bqnls"}
 
@@ -64,7 +64,7 @@ class AdhesiveALMM:
         adhesive.gradient(g, elastic, r)
         r *= 1.0 / problem.n
         if self.test is not None and self.test.history.out_of_time(adhesive.max_seconds):
-            gradient.set(0.0)  # ends the inner solve; the outer test reports the time limit
+            stop_subsolver(tao)  # ends the inner solve; the outer test reports the time limit
         return adhesive.energy(g, elastic)
 
     def _equality(self, tao, x, c):

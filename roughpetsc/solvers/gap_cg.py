@@ -73,6 +73,7 @@ class _Scratch:
         self.free = np.empty(size)
         self.open = np.empty(size, dtype=bool)
         self.mask = np.empty(size, dtype=bool)
+        self.free_part = np.empty(size)  # scratch of _feasible
         self.best = np.empty(size)  # an iterate near the lowest natural residual, returned by a stop short of it
 
 
@@ -129,16 +130,16 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
         count, = allsum(mpi, [np.count_nonzero(scratch.mask)])
         # The residual on the free set, at zero mean there (directions keep the mean gap).
         np.subtract(r, lam, out=response)
-        _restrict(mpi, response, free, count, work)
+        _restrict(mpi, response, free, count)
         operator.displacement(response_vec, preconditioned_vec)
-        _restrict(mpi, z, free, count, work)
+        _restrict(mpi, z, free, count)
         rz, r_old_z = allsum(mpi, [np.dot(response, z), np.dot(r_old, z)])
         beta = max((rz - r_old_z) / rz_old, 0.0) if iteration else 0.0
         np.copyto(r_old, response)
         rz_old = rz
         t *= beta
         t += z
-        _restrict(mpi, t, free, count, work)
+        _restrict(mpi, t, free, count)
         slope = _feasible(mpi, t, g, r, scratch, open_count)
         if not slope > 0:
             # Not a descent direction once feasible: the projected residual is one (CG restarts).
@@ -177,19 +178,19 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
                    reason=f"{reason} ({', '.join(notes)})" if notes else reason, history=history.as_array())
 
 
-def _restrict(mpi, v, free, count, work):
-    """``v`` restricted to the free set and shifted to zero mean there (in place; ``work`` is scratch)."""
+def _restrict(mpi, v, free, count):
+    """``v`` restricted to the free set (a 0/1 float mask) and shifted to zero mean there (in place)."""
+    total, = allsum(mpi, [np.dot(v, free)])
+    v -= total / count
     v *= free
-    total, = allsum(mpi, [v.sum()])
-    np.multiply(free, total / count, out=work)
-    v -= work
 
 
 def _law_curvature(law, mpi, g, t, work):
     """``<phi''(g), t^2>``: the law's part of the curvature along t (0 for a piecewise-linear law)."""
     if not law.curved:
         return 0.0
-    np.multiply(law.curvature(g), t, out=work)
+    law.curvature(g, out=work)
+    work *= t
     total, = allsum(mpi, [np.dot(work, t)])
     return total
 
@@ -202,11 +203,15 @@ def _feasible(mpi, t, g, r, scratch, open_count):
     steps along -t then need no projection, so the energy change of the line search is that of the
     projected iterate.
     """
-    np.greater(t, 0.0, out=scratch.mask)
-    np.copyto(scratch.mask, False, where=scratch.open)
-    np.copyto(t, 0.0, where=scratch.mask)
+    # Masks by arithmetic: copies and ufuncs under where= cost several passes each.
+    closed = np.logical_not(scratch.open, out=scratch.mask)
+    np.multiply(t, closed, out=scratch.free_part)
+    np.minimum(scratch.free_part, 0.0, out=scratch.free_part)  # closed nodes keep t <= 0
+    np.multiply(t, scratch.open, out=t)
+    t += scratch.free_part
     total, = allsum(mpi, [t.sum()])
-    np.subtract(t, total / open_count, out=t, where=scratch.open)
+    np.multiply(scratch.open, total / open_count, out=scratch.free_part)
+    t -= scratch.free_part
     slope, = allsum(mpi, [np.dot(r, t)])
     return slope
 
@@ -222,10 +227,11 @@ def _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, step, trial)
     """
     law, mpi = adhesive.scaled_law, adhesive.problem.mpi
     elastic_slope, = allsum(mpi, [np.dot(elastic, t)])
+    changes = law.energy_changes_from(g)
     for _ in range(MAX_BACKTRACKS):
         np.multiply(t, -step, out=trial)
         trial += g
-        law_change, = allsum(mpi, [law.energy_change(g, trial).sum()])
+        law_change, = allsum(mpi, [changes(trial, trial).sum()])
         change = step * (0.5 * step * curvature_elastic - elastic_slope) + law_change
         if change <= -ARMIJO * step * slope:
             return step

@@ -217,7 +217,7 @@ class PolonskyKeer:
             if bccg:
                 np.less(gap, 0.0, out=negative)
                 if upper is not None:
-                    np.copyto(negative, False, where=at_cap)
+                    negative &= np.logical_not(at_cap, out=opening)  # (a where= copy is ten times slower)
                 np.copyto(contact, 1.0, where=negative)
             if upper is not None:
                 # Plastic nodes whose gap opens leave the cap: they join the free set.
@@ -301,7 +301,7 @@ class PolonskyKeer:
                 # left for later, as rescaling beside capped nodes costs a fresh K p.
                 total, = allsum(mpi, [p.sum()])
                 if changed or abs(total - pbar * n) > 0.01 * self.rtol * pbar * n:
-                    fresh_needed |= self._restore_load_below_cap(p, displacement, pbar * n, upper)
+                    fresh_needed |= self._restore_load_below_cap(p, displacement, pbar * n, upper, negative)
                     if self.stopped_by:
                         reason = PETSc.TAO.Reason.DIVERGED_USER
                         break
@@ -331,8 +331,10 @@ class PolonskyKeer:
         if problem.upper_bound is not None:
             np.minimum(p, problem.upper_bound, out=p)
 
-    def _restore_load_below_cap(self, p, displacement, total_load, upper):
+    def _restore_load_below_cap(self, p, displacement, total_load, upper, capped):
         """Rescale the nodes below the cap ``upper`` so that ``sum(p) = total_load``; True if K p is stale.
+
+        ``capped`` is a boolean scratch array of p's shape.
 
         The capped nodes keep ``p = upper``; a node that the rescaling lifts above the cap is capped in
         turn (a few rounds at most). While no node is capped this is the uniform rescaling, which
@@ -343,8 +345,8 @@ class PolonskyKeer:
         stale = False
         for _ in range(8):
             # Capped nodes hold p = upper exactly (the projection sets them so): the free load is the rest.
-            capped = np.flatnonzero(p >= upper)
-            n_capped, total = allsum(mpi, [capped.size, p.sum()])
+            np.greater_equal(p, upper, out=capped)
+            n_capped, total = allsum(mpi, [np.count_nonzero(capped), p.sum()])
             wanted = total_load - upper * n_capped
             if wanted <= 0:
                 # The capped nodes alone carry more than the load: scale every node down, off the cap.
@@ -358,7 +360,7 @@ class PolonskyKeer:
                 return True
             scale = wanted / free_load
             p *= scale
-            p[capped] = upper
+            np.putmask(p, capped, upper)
             if n_capped or stale:
                 stale = True
             else:

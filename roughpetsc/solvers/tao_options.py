@@ -4,6 +4,8 @@ Every TAO object of a solver carries the options prefix its :class:`~roughpetsc.
 was given (None: the unprefixed command line); everything here reads and writes options under that prefix.
 """
 
+import ctypes
+import functools
 from contextlib import contextmanager
 
 from petsc4py import PETSc
@@ -30,6 +32,27 @@ def max_seconds(prefix=None):
         raise UserError(f"{option_name('solve_max_time', prefix)} must be a non-negative number of seconds, "
                         f"got {seconds}")
     return seconds
+
+
+@functools.cache
+def _petsc_library():
+    """The PETSc shared library, through petsc4py's extension module (dlsym searches its dependencies)."""
+    return ctypes.CDLL(PETSc.__file__)
+
+
+def stop_subsolver(tao):
+    """Set the reason of ALMM's subsolver to DIVERGED_USER, so that its solve ends at its next convergence test.
+
+    TAO's default test leaves a reason already set. petsc4py 3.18 does not wrap ``TaoALMMGetSubsolver``,
+    so it and ``TaoSetConvergedReason`` are called through ctypes.
+    """
+    library = _petsc_library()
+    subsolver = ctypes.c_void_p()
+    error = library.TaoALMMGetSubsolver(ctypes.c_void_p(tao.handle), ctypes.byref(subsolver))
+    if error == 0:
+        error = library.TaoSetConvergedReason(subsolver, ctypes.c_int(int(PETSc.TAO.Reason.DIVERGED_USER)))
+    if error != 0:
+        raise RuntimeError(f"PETSc error {error} while stopping the ALMM subsolver at the time limit")
 
 
 def set_from_options(tao, cleanup):
