@@ -9,6 +9,6 @@ setup(
     packages=find_packages(include=["roughpetsc", "roughpetsc.*"]),
     python_requires=">=3.9",
     # On Debian these come from apt (tools/bootstrap.sh); elsewhere see README "Install from PyPI sources".
-    install_requires=["numpy", "scipy", "petsc4py", "mpi4py", "mpi4py-fft", "pyfftw", "h5py", "matplotlib"],
+    install_requires=["numpy", "scipy", "petsc4py", "mpi4py", "mpi4py-fft", "pyfftw", "h5py", "matplotlib", "numba"],
     entry_points={"console_scripts": ["roughpetsc=roughpetsc.cli:main"]},
 )

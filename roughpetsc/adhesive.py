@@ -35,7 +35,8 @@ import numpy as np
 
 from .contact import Result, measure
 from .errors import ParameterError
-from .kkt import KKTReport, allsum, allmin
+from .kkt import KKTReport, allmax, allmin, allsum
+from .solvers import cg_kernels as kernels
 from .solvers.gap_cg import gap_cg
 
 SOLVERS = ("gapcg", "almm")
@@ -111,18 +112,14 @@ class AdhesiveContact:
         out += elastic
 
     def multiplier(self, g, r, open_nodes):
-        """lambda, the mean of r out of contact; ``open_nodes`` (bool, written) marks g > 0. Also their count."""
-        np.greater(g, 0.0, out=open_nodes)
-        count, r_sum = allsum(self.problem.mpi, [np.count_nonzero(open_nodes), r.sum(where=open_nodes)])
+        """lambda, the mean of r out of contact; ``open_nodes`` (bool, contiguous, written) marks g > 0. Also their
+        count."""
+        count, r_sum = allsum(self.problem.mpi, kernels.open_sums(g.ravel(), r.ravel(), open_nodes.reshape(-1)))
         return (r_sum / count if count else 0.0), count
 
-    def natural(self, g, r, lam, work):
-        """The natural residual max |min(g, (r - lambda) / sqrt(m0^p))| (scaled gaps); ``work`` is scratch."""
-        np.subtract(r, lam, out=work)
-        work *= 1.0 / self.pressure_scale
-        np.minimum(work, g, out=work)
-        np.abs(work, out=work)
-        return float(-allmin(self.problem.mpi, [-np.max(work, initial=0.0)])[0])
+    def natural(self, g, r, lam):
+        """The natural residual max |min(g, (r - lambda) / sqrt(m0^p))| (scaled gaps)."""
+        return float(allmax(self.problem.mpi, [kernels.gap_natural(g.ravel(), r.ravel(), lam, self.pressure_scale)])[0])
 
     def stationarity(self, g, elastic):
         """``(r, lambda, report)`` of local arrays ``g`` and ``elastic`` = S (g + h) (module docstring).
@@ -135,7 +132,7 @@ class AdhesiveContact:
         self.gradient(g, elastic, r)
         out_of_contact = np.empty(g.shape, dtype=bool)
         lam, _ = self.multiplier(g, r, out_of_contact)
-        natural = self.natural(g, r, lam, np.empty_like(g))
+        natural = self.natural(g, r, lam)
         excess = (r - lam) / self.pressure_scale
         min_c = np.min(excess, where=~out_of_contact, initial=np.inf)
         equilibrium = np.abs(excess, where=out_of_contact, out=np.zeros_like(excess))

@@ -14,6 +14,11 @@ os.environ.setdefault("ROUGHPETSC_FFT_WISDOM", "none")
 petsc4py.init([sys.argv[0]])
 
 
+def pytest_configure(config):
+    # Debian's llvmlite (under numba) still calls a deprecated importlib.resources function.
+    config.addinivalue_line("filterwarnings", "ignore:path is deprecated:DeprecationWarning")
+
+
 def pytest_report_header(config):
     effort = os.environ.get("ROUGHPETSC_FFT_EFFORT") or "as each test asks"
     return f"roughpetsc: FFTW planner effort {effort}, wisdom cache {os.environ['ROUGHPETSC_FFT_WISDOM']}"

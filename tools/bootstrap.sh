@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(python3-petsc4py python3-slepc4py python3-mpi4py python3-mpi4py-fft python3-pyfftw
-          python3-h5py-mpi python3-scipy python3-matplotlib python3-pytest python3-venv python3-pip
+          python3-h5py-mpi python3-scipy python3-matplotlib python3-numba python3-pytest python3-venv python3-pip
           libpetsc-real3.18-dev libslepc-real3.18-dev openmpi-bin)
 
 missing=()

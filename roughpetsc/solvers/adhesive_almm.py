@@ -117,10 +117,10 @@ class _NaturalTest:
         adhesive.elastic_pressure(x, self.elastic_vec)
         g = problem.local(x, readonly=True).ravel()
         elastic = problem.local(self.elastic_vec, readonly=True).ravel()
-        r, work, open_nodes = np.empty_like(g), np.empty_like(g), np.empty(g.shape, dtype=bool)
+        r, open_nodes = np.empty_like(g), np.empty(g.shape, dtype=bool)
         adhesive.gradient(g, elastic, r)
         lam, _ = adhesive.multiplier(g, r, open_nodes)
-        natural = adhesive.natural(g, r, lam, work)
+        natural = adhesive.natural(g, r, lam)
         total, = allsum(problem.mpi, [g.sum()])
         natural = max(natural, abs(total / problem.n - self.target))  # the equality counts too
         iteration = tao.getIterationNumber()

@@ -23,6 +23,7 @@ lowest it saw (a copy is kept each time the residual halves, not at every iterat
 import numpy as np
 
 from ..kkt import STAGNATION_ITERATIONS, History, allsum
+from . import cg_kernels as kernels
 from .protocol import Outcome
 
 REFRESH = 50  # recompute S g at least every REFRESH iterations (the update S g -= step S t drifts)
@@ -72,8 +73,6 @@ class _Scratch:
         self.work = np.empty(size)
         self.free = np.empty(size)
         self.open = np.empty(size, dtype=bool)
-        self.mask = np.empty(size, dtype=bool)
-        self.free_part = np.empty(size)  # scratch of _feasible
         self.best = np.empty(size)  # an iterate near the lowest natural residual, returned by a stop short of it
 
 
@@ -102,7 +101,7 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
             fresh_needed, since_fresh = False, 0
         adhesive.gradient(g, elastic, r)
         lam, open_count = adhesive.multiplier(g, r, scratch.open)
-        natural = adhesive.natural(g, r, lam, work)
+        natural = adhesive.natural(g, r, lam)
         if natural <= adhesive.rtol and since_fresh:
             fresh_needed = True  # confirm on a freshly computed S g
             continue
@@ -123,49 +122,40 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
         if iteration - best_iteration >= STAGNATION_ITERATIONS:
             reason, stopped_by = "DIVERGED_USER", "stagnation"
             break
-        # The free set: out of contact, and the contact nodes that pull (they open along the direction).
-        np.less(r, lam, out=scratch.mask)
-        scratch.mask |= scratch.open
-        np.copyto(free, scratch.mask)
-        count, = allsum(mpi, [np.count_nonzero(scratch.mask)])
-        # The residual on the free set, at zero mean there (directions keep the mean gap).
-        np.subtract(r, lam, out=response)
-        _restrict(mpi, response, free, count)
+        # The free set: out of contact, and the contact nodes that pull (they open along the direction);
+        # the residual on it, at zero mean there (directions keep the mean gap).
+        count, total = allsum(mpi, kernels.gap_free_residual(r, lam, scratch.open, free, response))
+        kernels.shift_on(response, free, total / count)
         operator.displacement(response_vec, preconditioned_vec)
         _restrict(mpi, z, free, count)
-        rz, r_old_z = allsum(mpi, [np.dot(response, z), np.dot(r_old, z)])
+        rz, r_old_z, t_free, z_sum = allsum(mpi, kernels.conjugacy_sums(response, z, r_old, t, free, True))
         beta = max((rz - r_old_z) / rz_old, 0.0) if iteration else 0.0
-        np.copyto(r_old, response)
         rz_old = rz
-        t *= beta
-        t += z
-        _restrict(mpi, t, free, count)
-        slope = _feasible(mpi, t, g, r, scratch, open_count)
+        # t = beta t + z, at zero mean on the free set.
+        kernels.new_direction(t, free, beta, (beta * t_free + z_sum) / count, z)
+        slope = _feasible(mpi, t, r, scratch.open, open_count)
         if not slope > 0:
             # Not a descent direction once feasible: the projected residual is one (CG restarts).
             np.copyto(t, response)
-            slope = _feasible(mpi, t, g, r, scratch, open_count)
+            slope = _feasible(mpi, t, r, scratch.open, open_count)
             r_old[...] = 0.0
             if not slope > 0:
                 reason, stopped_by = "DIVERGED_LS_FAILURE", "no feasible descent direction (round-off)"
                 break
         operator.elastic_pressure(direction_vec, response_vec)  # S t
-        curvature_elastic, = allsum(mpi, [np.dot(t, response)])
+        curvature_elastic, elastic_slope = allsum(mpi, kernels.two_dots(t, response, elastic))
         curvature = curvature_elastic + _law_curvature(law, mpi, g, t, work)
         if not curvature > 0:
             curvature = curvature_elastic
-        step = _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, slope / curvature, work)
+        step = _armijo_step(adhesive, g, t, slope, curvature_elastic, elastic_slope, slope / curvature, work)
         if step is None:
             reason, stopped_by = "DIVERGED_LS_FAILURE", "no decrease of the energy along the direction"
             break
-        np.multiply(t, step, out=work)
-        g -= work
-        if allsum(mpi, [np.count_nonzero(np.less(g, 0.0, out=scratch.mask))])[0]:
+        if allsum(mpi, [kernels.gap_step(g, t, step)])[0]:
             project_mean(mpi, g, target, n)
             fresh_needed = True
         else:
-            np.multiply(response, step, out=work)
-            elastic -= work
+            kernels.subtract_scaled(elastic, response, step)
         since_fresh += 1
         iteration += 1
     notes = [stopped_by] if stopped_by else []
@@ -180,9 +170,8 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
 
 def _restrict(mpi, v, free, count):
     """``v`` restricted to the free set (a 0/1 float mask) and shifted to zero mean there (in place)."""
-    total, = allsum(mpi, [np.dot(v, free)])
-    v -= total / count
-    v *= free
+    total, = allsum(mpi, [kernels.masked_sum(v, free)])
+    kernels.shift_on(v, free, total / count)
 
 
 def _law_curvature(law, mpi, g, t, work):
@@ -195,28 +184,20 @@ def _law_curvature(law, mpi, g, t, work):
     return total
 
 
-def _feasible(mpi, t, g, r, scratch, open_count):
+def _feasible(mpi, t, r, open_nodes, open_count):
     """Make ``-t`` a feasible direction at g = 0 (in place); returns the slope ``<r, t>`` of the energy.
 
     A contact node (g = 0) may only open: where t > 0 it is set to 0, and the mean of t is restored on
-    the ``open_count`` nodes out of contact (``scratch.open``, g > 0), which can move either way; small
+    the ``open_count`` nodes out of contact (``open_nodes``, g > 0), which can move either way; small
     steps along -t then need no projection, so the energy change of the line search is that of the
     projected iterate.
     """
-    # Masks by arithmetic: copies and ufuncs under where= cost several passes each.
-    closed = np.logical_not(scratch.open, out=scratch.mask)
-    np.multiply(t, closed, out=scratch.free_part)
-    np.minimum(scratch.free_part, 0.0, out=scratch.free_part)  # closed nodes keep t <= 0
-    np.multiply(t, scratch.open, out=t)
-    t += scratch.free_part
-    total, = allsum(mpi, [t.sum()])
-    np.multiply(scratch.open, total / open_count, out=scratch.free_part)
-    t -= scratch.free_part
-    slope, = allsum(mpi, [np.dot(r, t)])
+    total, = allsum(mpi, [kernels.close_contact_nodes(t, open_nodes)])
+    slope, = allsum(mpi, [kernels.shift_open_slope(t, open_nodes, total / open_count, r)])
     return slope
 
 
-def _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, step, trial):
+def _armijo_step(adhesive, g, t, slope, curvature_elastic, elastic_slope, step, trial):
     """The first of ``step``, step/2, ... along -t that decreases the energy enough (None if none does).
 
     The test is on the energy along the line before the projection (phi continued below g = 0 by its
@@ -226,7 +207,6 @@ def _armijo_step(adhesive, g, elastic, t, slope, curvature_elastic, step, trial)
     sum (phi(g - s t) - phi(g)).
     """
     law, mpi = adhesive.scaled_law, adhesive.problem.mpi
-    elastic_slope, = allsum(mpi, [np.dot(elastic, t)])
     changes = law.energy_changes_from(g)
     for _ in range(MAX_BACKTRACKS):
         np.multiply(t, -step, out=trial)

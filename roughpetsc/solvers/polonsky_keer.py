@@ -42,8 +42,9 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..errors import UserError
-from ..kkt import STAGNATION_ITERATIONS, History, allsum, report
+from ..kkt import STAGNATION_ITERATIONS, History, KKTReport, allmax, allsum
 from ..preconditioner import FourierPreconditioner
+from . import cg_kernels as kernels
 from .tao_options import option_name
 
 PRECONDITIONERS = ("none", "fourier")
@@ -146,18 +147,17 @@ class PolonskyKeer:
         displacement_vec, direction_vec, response_vec = self.vecs[:3]
         displacement = problem.local(displacement_vec).ravel()  # K p
         t = problem.local(direction_vec).ravel()
-        response = problem.local(response_vec).ravel()  # K t, then scratch
+        response = problem.local(response_vec).ravel()  # K t, then the residual on the free set
         gap = problem.local(self.vecs[3]).ravel()
         z = problem.local(self.vecs[4]).ravel()  # preconditioned residual
         r_old = problem.local(self.vecs[5]).ravel()
         r_old[...] = 0.0
-        upper = problem.upper_bound
+        cap = problem.upper_bound
+        upper = np.inf if cap is None else cap  # the kernels' cap: inf reduces every test to the uncapped one
         bccg = self.active_set == "bccg"
         precondition = self.preconditioner == "fourier"
-        contact = np.empty_like(p)  # 1.0 on the contact set, 0.0 elsewhere: masks as dot products
-        negative = np.empty(p.shape, dtype=bool)  # scratch mask, so the loop allocates no N^2 temporaries
-        at_cap = np.empty(p.shape, dtype=bool) if upper is not None else None
-        opening = np.empty(p.shape, dtype=bool) if upper is not None else None
+        contact = np.empty_like(p)  # 1.0 on the contact (then free) set, 0.0 elsewhere
+        negative = None if bccg else np.empty(p.shape, dtype=bool)  # PK's entering nodes
         t[...] = 0.0
         if not load_control:
             self.separation = self.target_separation
@@ -178,20 +178,11 @@ class PolonskyKeer:
                 operator.displacement(pressure, displacement_vec)
                 since_fresh, fresh_needed = 0, False
             fresh = since_fresh == 0
-            np.greater(p, 0.0, out=contact)
-            if upper is not None:
-                # Plastic nodes (their gap may be negative) leave the contact set: arithmetic on the masks,
-                # as a copy under a mask (np.copyto with where=) costs several passes.
-                np.greater_equal(p, upper, out=at_cap)
-                contact -= at_cap
-            np.subtract(displacement, h, out=gap)
-            if load_control:
-                # d is fixed by a zero mean gap on the (elastic) contact set: g = K p - h + d.
-                count, gap_sum = allsum(mpi, [contact.sum(), np.dot(gap, contact)])
-                if count:  # (a fully plastic contact keeps the last d)
-                    self.separation = -gap_sum / count
-            gap += self.separation
-            kkt = report(mpi, p, gap, n, pbar, upper, scratch=(z, response), feasibility=False)  # both spent here
+            # Plastic nodes (their gap may be negative) are not in the contact set that fixes d.
+            count, gap_sum, total = allsum(mpi, kernels.contact_and_gap(p, displacement, h, gap, contact, upper))
+            if load_control and count:  # d makes the mean gap on the contact set zero (a fully plastic
+                self.separation = -gap_sum / count  # contact keeps the last d)
+            kkt = self._report(p, gap, total, pbar, upper)
             converged = kkt.natural <= self.rtol and (kkt.load_error is None or kkt.load_error <= self.rtol)
             if converged and not fresh and self.confirm:
                 fresh_needed = True  # confirm on a freshly computed K p before stopping
@@ -213,95 +204,64 @@ class PolonskyKeer:
                 # Round-off in the gap bounds the residual from below (its floor); CG then wanders.
                 reason, self.stopped_by = PETSc.TAO.Reason.DIVERGED_USER, "stagnation"
                 break
-            # The free set: the contact set, and under BCCG also the nodes out of contact that overlap.
-            if bccg:
-                np.less(gap, 0.0, out=negative)
-                if upper is not None:
-                    negative &= np.logical_not(at_cap, out=opening)  # (a where= copy is ten times slower)
-                np.copyto(contact, 1.0, where=negative)
-            if upper is not None:
-                # Plastic nodes whose gap opens leave the cap: they join the free set.
-                np.greater(gap, 0.0, out=opening)
-                opening &= at_cap
-                contact += opening  # 0.0 before: they are at the cap
-            if bccg or not load_control or upper is not None:  # (opening nodes may have joined the free set)
-                count, gap_sum = allsum(mpi, [contact.sum(), np.dot(gap, contact)])
+            # The free set: the contact set, the plastic nodes whose gap opens (they leave the cap), and
+            # under BCCG the nodes out of contact that overlap.
+            if bccg or not load_control or cap is not None:
+                count, gap_sum = allsum(mpi, kernels.free_set(p, gap, contact, upper, bccg))
             else:
                 gap_sum = 0.0  # the free set is the contact set, where d has made the mean gap zero
+            # Directions keep the load: under load control the residual has zero mean on the free set.
+            mean = gap_sum / count if load_control and gap_sum else 0.0
             r = response
-            if load_control and gap_sum:
-                # Directions keep the load: the residual has zero mean on the free set.
-                np.subtract(gap, gap_sum / count, out=r)
-                r *= contact
-            else:
-                np.multiply(gap, contact, out=r)
+            kernels.free_residual(gap, contact, mean, r)
             if precondition:
                 self.fourier.apply(r, z, contact, count, keep_load=load_control)
                 direction = z
             else:
                 direction = r
+            rz, r_old_z, t_free, direction_sum = allsum(
+                mpi, kernels.conjugacy_sums(r, direction, r_old, t, contact, bccg))
             if bccg:
                 # Polak-Ribiere (clipped at 0): conjugacy survives changes of the free set.
-                rz, r_old_z = allsum(mpi, [np.dot(r, direction), np.dot(r_old, direction)])
                 beta = max((rz - r_old_z) / rz_old if iteration else 0.0, 0.0)
-                np.copyto(r_old, r)
             else:
-                rz, = allsum(mpi, [np.dot(r, direction)])
                 beta = rz / rz_old if conjugate else 0.0
-            # Conjugate direction on the free set: t = z + beta t.
-            t *= contact
-            t *= beta
-            t += direction
             rz_old = rz
-            if load_control and upper is not None and count:
-                # t at zero sum keeps the load, which beside capped nodes only a fresh K p could restore.
-                t_sum, = allsum(mpi, [t.sum()])
-                np.multiply(contact, t_sum / count, out=response)
-                t -= response
+            # Conjugate direction on the free set: t = z + beta t. Under a cap and load control it is kept
+            # at zero sum (it keeps the load, which beside capped nodes only a fresh K p could restore).
+            shift = (beta * t_free + direction_sum) / count if load_control and cap is not None and count else 0.0
+            kernels.new_direction(t, contact, beta, shift, direction)
             operator.displacement(direction_vec, response_vec)
-            q_sum, t_sum, numerator, q_dot_t = allsum(mpi, [np.dot(response, contact), t.sum(), np.dot(gap, t),
-                                                             np.dot(response, t)])
+            q_sum, t_sum, numerator, q_dot_t = allsum(mpi, kernels.step_sums(response, contact, t, gap))
             # Under load control K t enters less its mean on the contact set (t vanishes off it).
             denominator = q_dot_t - q_sum / count * t_sum if load_control else q_dot_t
             if not denominator > 0:
                 reason = PETSc.TAO.Reason.DIVERGED_LS_FAILURE
                 break
             step = numerator / denominator
-            # K p - step K t, the displacement of the unprojected step; response is spent after this.
-            response *= -step
-            displacement += response
-            np.multiply(t, step, out=response)
-            p -= response
-            # Projection onto p >= 0; under PK, nodes out of contact that overlap enter and CG restarts.
-            clipped = np.count_nonzero(np.less(p, 0.0, out=negative))
-            np.maximum(p, 0.0, out=p)
-            if upper is not None:
-                clipped += np.count_nonzero(np.greater(p, upper, out=negative))
-                np.minimum(p, upper, out=p)
+            # p - step t projected onto [0, upper]; K p - step K t, the displacement of the unprojected step.
+            clipped, total = kernels.take_step(p, t, displacement, response, step, upper)
             if bccg:
-                changed, = allsum(mpi, [clipped])
+                changed, total = allsum(mpi, [clipped, total])
                 entering = 0
             else:
+                # PK: nodes out of contact that overlap enter with p = -step g, and CG restarts.
                 overlap = np.less(gap, 0.0, out=negative)
                 overlap &= p == 0
                 changed, entering = allsum(mpi, [clipped, np.count_nonzero(overlap)])
                 if entering:
-                    np.multiply(gap, -step, out=response)
-                    np.copyto(p, response, where=overlap)
+                    np.copyto(p, -step * gap, where=overlap)
+                total, = allsum(mpi, [p.sum()])
                 conjugate = entering == 0
             fresh_needed = bool(changed or entering)
-            if load_control and upper is None:
-                total, = allsum(mpi, [p.sum()])
-                scale = pbar * n / total
-                p *= scale
-                displacement *= scale
+            if load_control and cap is None:
+                kernels.rescale(p, displacement, pbar * n / total)
             elif load_control:
                 # Directions keep the load on the free set: it drifts where the projection clipped (then
                 # K p is computed afresh anyway) and slowly otherwise; a drift well inside the tolerance is
                 # left for later, as rescaling beside capped nodes costs a fresh K p.
-                total, = allsum(mpi, [p.sum()])
                 if changed or abs(total - pbar * n) > 0.01 * self.rtol * pbar * n:
-                    fresh_needed |= self._restore_load_below_cap(p, displacement, pbar * n, upper, negative)
+                    fresh_needed |= self._restore_load_below_cap(p, displacement, pbar * n, cap)
                     if self.stopped_by:
                         reason = PETSc.TAO.Reason.DIVERGED_USER
                         break
@@ -310,6 +270,19 @@ class PolonskyKeer:
             tao.setIterationNumber(iteration)
         tao.setIterationNumber(iteration)
         tao.setConvergedReason(reason)
+
+    def _report(self, p, gap, total, pbar, upper):
+        """The KKT report of the iterate (``gap += separation`` on the way), as :func:`~roughpetsc.kkt.report`
+        without its feasibility minima; ``total`` is the global sum of p."""
+        problem = self.problem
+        mean_p = total / problem.n
+        scale = pbar if pbar else (mean_p if mean_p > 0 else 1.0)
+        natural, complementarity = kernels.natural_residual(p, gap, self.separation, scale, upper)
+        natural, = allmax(problem.mpi, [natural])
+        complementarity, = allsum(problem.mpi, [complementarity])
+        return KKTReport(natural=float(natural), complementarity=float(complementarity / total) if total > 0 else 0.0,
+                         min_p=np.nan, min_g=np.nan,
+                         load_error=None if pbar is None else float(abs(mean_p - pbar) / pbar))
 
     def _interference_start(self, pressure, p, h):
         """Under displacement control, an empty start becomes the best multiple of the interference.
@@ -331,10 +304,8 @@ class PolonskyKeer:
         if problem.upper_bound is not None:
             np.minimum(p, problem.upper_bound, out=p)
 
-    def _restore_load_below_cap(self, p, displacement, total_load, upper, capped):
+    def _restore_load_below_cap(self, p, displacement, total_load, upper):
         """Rescale the nodes below the cap ``upper`` so that ``sum(p) = total_load``; True if K p is stale.
-
-        ``capped`` is a boolean scratch array of p's shape.
 
         The capped nodes keep ``p = upper``; a node that the rescaling lifts above the cap is capped in
         turn (a few rounds at most). While no node is capped this is the uniform rescaling, which
@@ -345,8 +316,7 @@ class PolonskyKeer:
         stale = False
         for _ in range(8):
             # Capped nodes hold p = upper exactly (the projection sets them so): the free load is the rest.
-            np.greater_equal(p, upper, out=capped)
-            n_capped, total = allsum(mpi, [np.count_nonzero(capped), p.sum()])
+            n_capped, total = allsum(mpi, kernels.capped_load(p, upper))
             wanted = total_load - upper * n_capped
             if wanted <= 0:
                 # The capped nodes alone carry more than the load: scale every node down, off the cap.
@@ -359,15 +329,12 @@ class PolonskyKeer:
                 self.stopped_by = "the cap carries the whole load"
                 return True
             scale = wanted / free_load
-            p *= scale
-            np.putmask(p, capped, upper)
+            lifted, = allsum(mpi, [kernels.scale_below_cap(p, upper, scale)])
             if n_capped or stale:
                 stale = True
             else:
                 displacement *= scale
-            above, = allsum(mpi, [np.count_nonzero(p > upper)])
-            if not above:
+            if not lifted:
                 break
-            np.minimum(p, upper, out=p)
             stale = True
         return bool(stale)

@@ -1,0 +1,285 @@
+"""The elementwise work of one iteration of the CG solvers, fused: Polonsky-Keer on the pressure
+(:mod:`~roughpetsc.solvers.polonsky_keer`) and the adhesive gap CG (:mod:`~roughpetsc.solvers.gap_cg`).
+
+Between two reductions over the ranks (or two FFTs) an iteration makes several passes over the local
+arrays; as numpy calls each is a sweep of its own through memory, and at 1024^2 those sweeps took more
+time than the iteration's two FFT pairs. Each function here is one compiled loop (numba) over the local
+flat arrays that does a whole stretch of the iteration and returns its local sums, so an iteration sweeps
+the memory about ten times instead of fifty. The arithmetic is that of the numpy version node by node; the
+sums may be reassociated (``fastmath={"reassoc"}``, so that they vectorise): their order is not numpy's.
+
+The hardness cap enters as ``upper`` (``inf`` without one): a node is capped when ``p >= upper``, and the
+arithmetic with ``inf`` reduces every test to the uncapped one. Masks are 0.0/1.0 float arrays (``contact``,
+``free``) or boolean arrays (``open_nodes``).
+"""
+
+from numba import njit
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def contact_and_gap(p, displacement, heights, gap, contact, upper):
+    """``gap = K p - h``; ``contact`` 1.0 on the elastic contact set ``0 < p < upper``, 0.0 elsewhere.
+
+    Returns the local ``(|C|, sum of gap over C, sum of p)``.
+    """
+    count = gap_sum = total = 0.0
+    for i in range(p.size):
+        g = displacement[i] - heights[i]
+        gap[i] = g
+        inside = 1.0 if 0.0 < p[i] < upper else 0.0
+        contact[i] = inside
+        count += inside
+        gap_sum += g * inside
+        total += p[i]
+    return count, gap_sum, total
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def natural_residual(p, gap, separation, scale, upper):
+    """``gap += separation`` in place; the natural residual of the box 0 <= p <= upper, in units of ``scale``.
+
+    ``max |mid(p / scale, g, (p - upper) / scale)|`` (docs/conventions.md) and the local ``sum(p g)`` over
+    the nodes below the cap, as :func:`roughpetsc.kkt.report` gives them.
+    """
+    natural = complementarity = 0.0
+    inverse = 1.0 / scale
+    high = upper * inverse
+    for i in range(p.size):
+        g = gap[i] + separation
+        gap[i] = g
+        pressure = p[i] * inverse
+        residual = min(max(g, pressure - high), pressure)
+        natural = max(natural, abs(residual))
+        if p[i] < upper:
+            complementarity += p[i] * g
+    return natural, complementarity
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def free_set(p, gap, contact, upper, overlapping):
+    """The free set of the step into ``contact``; returns the local ``(|F|, sum of gap over F)``.
+
+    F is the elastic contact set, the capped nodes whose gap opens (they leave the cap), and with
+    ``overlapping`` (BCCG) the nodes below the cap whose gap is negative.
+    """
+    count = gap_sum = 0.0
+    for i in range(p.size):
+        g = gap[i]
+        if p[i] >= upper:
+            inside = g > 0.0
+        else:
+            inside = p[i] > 0.0 or (overlapping and g < 0.0)
+        value = 1.0 if inside else 0.0
+        contact[i] = value
+        count += value
+        gap_sum += g * value
+    return count, gap_sum
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def free_residual(gap, contact, mean, residual):
+    """``residual = (gap - mean)`` on the free set, 0 elsewhere."""
+    for i in range(gap.size):
+        residual[i] = (gap[i] - mean) * contact[i]
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def conjugacy_sums(residual, direction, previous, t, contact, keep_previous):
+    """Local ``(r'z, r_old'z, sum of t over F, sum of z)`` with z = ``direction``; ``previous = residual``
+    afterwards when ``keep_previous`` (the Polak-Ribiere beta needs the last residual)."""
+    rz = previous_z = t_free = direction_sum = 0.0
+    for i in range(residual.size):
+        z = direction[i]
+        rz += residual[i] * z
+        previous_z += previous[i] * z
+        t_free += t[i] * contact[i]
+        direction_sum += z
+        if keep_previous:
+            previous[i] = residual[i]
+    return rz, previous_z, t_free, direction_sum
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def new_direction(t, contact, beta, shift, direction):
+    """``t = (beta t - shift)`` on the free set ``+ direction``: the conjugate direction, less ``shift`` on F."""
+    for i in range(t.size):
+        t[i] = contact[i] * (beta * t[i] - shift) + direction[i]
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def step_sums(response, contact, t, gap):
+    """Local ``(sum of K t over F, sum of t, g't, t'K t)``: what the exact step along t needs."""
+    response_free = t_sum = numerator = curvature = 0.0
+    for i in range(t.size):
+        response_free += response[i] * contact[i]
+        t_sum += t[i]
+        numerator += gap[i] * t[i]
+        curvature += response[i] * t[i]
+    return response_free, t_sum, numerator, curvature
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def take_step(p, t, displacement, response, step, upper):
+    """``p -= step t`` projected onto [0, upper], ``K p -= step K t`` (unprojected).
+
+    Returns the local ``(number of nodes the projection moved, sum of p)``.
+    """
+    clipped = 0
+    total = 0.0
+    for i in range(p.size):
+        displacement[i] -= step * response[i]
+        value = p[i] - step * t[i]
+        if value < 0.0:
+            value = 0.0
+            clipped += 1
+        elif value > upper:
+            value = upper
+            clipped += 1
+        p[i] = value
+        total += value
+    return clipped, total
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def rescale(p, displacement, factor):
+    """``p *= factor`` and ``K p *= factor``."""
+    for i in range(p.size):
+        p[i] *= factor
+        displacement[i] *= factor
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def capped_load(p, upper):
+    """Local ``(number of nodes at the cap, sum of p)``."""
+    capped = 0
+    total = 0.0
+    for i in range(p.size):
+        if p[i] >= upper:
+            capped += 1
+        total += p[i]
+    return capped, total
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def scale_below_cap(p, upper, factor):
+    """``p *= factor`` below the cap, the capped nodes kept at it; a node lifted above the cap is capped.
+
+    Returns the local number of nodes so capped.
+    """
+    lifted = 0
+    for i in range(p.size):
+        if p[i] < upper:
+            value = p[i] * factor
+            if value > upper:
+                value = upper
+                lifted += 1
+            p[i] = value
+    return lifted
+
+
+
+# --- the adhesive gap CG ---------------------------------------------------------------------------------
+@njit(cache=True, fastmath={"reassoc"})
+def open_sums(g, r, open_nodes):
+    """``open_nodes = g > 0``; local ``(number of open nodes, sum of r over them)``."""
+    count = 0
+    r_sum = 0.0
+    for i in range(g.size):
+        is_open = g[i] > 0.0
+        open_nodes[i] = is_open
+        if is_open:
+            count += 1
+            r_sum += r[i]
+    return count, r_sum
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def gap_natural(g, r, multiplier, scale):
+    """Local ``max |min(g, (r - multiplier) / scale)|``."""
+    natural = 0.0
+    inverse = 1.0 / scale
+    for i in range(g.size):
+        natural = max(natural, abs(min(g[i], (r[i] - multiplier) * inverse)))
+    return natural
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def gap_free_residual(r, multiplier, open_nodes, free, residual):
+    """The free set (open nodes and the contact nodes that pull, ``r < multiplier``) into ``free`` and
+    ``residual = r - multiplier`` on it; local ``(|F|, sum of the residual)``."""
+    count = total = 0.0
+    for i in range(r.size):
+        value = r[i] - multiplier
+        inside = 1.0 if open_nodes[i] or value < 0.0 else 0.0
+        free[i] = inside
+        residual[i] = value * inside
+        count += inside
+        total += value * inside
+    return count, total
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def masked_sum(v, mask):
+    """Local ``sum of v over the mask``."""
+    total = 0.0
+    for i in range(v.size):
+        total += v[i] * mask[i]
+    return total
+
+
+@njit(cache=True)
+def shift_on(v, mask, shift):
+    """``v = (v - shift)`` on the mask, 0 elsewhere."""
+    for i in range(v.size):
+        v[i] = (v[i] - shift) * mask[i]
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def close_contact_nodes(t, open_nodes):
+    """``t = min(t, 0)`` at the contact nodes (a node in contact may only open along -t); local sum of t."""
+    total = 0.0
+    for i in range(t.size):
+        if not open_nodes[i] and t[i] > 0.0:
+            t[i] = 0.0
+        total += t[i]
+    return total
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def shift_open_slope(t, open_nodes, shift, r):
+    """``t -= shift`` on the open nodes; local slope ``r't``."""
+    slope = 0.0
+    for i in range(t.size):
+        if open_nodes[i]:
+            t[i] -= shift
+        slope += r[i] * t[i]
+    return slope
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def two_dots(t, response, elastic):
+    """Local ``(t'S t, t'S(g + h))`` with ``response`` = S t and ``elastic`` = S (g + h)."""
+    curvature = slope = 0.0
+    for i in range(t.size):
+        curvature += t[i] * response[i]
+        slope += t[i] * elastic[i]
+    return curvature, slope
+
+
+@njit(cache=True)
+def gap_step(g, t, step):
+    """``g -= step t``; the local number of negative gaps after it."""
+    negative = 0
+    for i in range(g.size):
+        value = g[i] - step * t[i]
+        g[i] = value
+        if value < 0.0:
+            negative += 1
+    return negative
+
+
+@njit(cache=True)
+def subtract_scaled(v, w, factor):
+    """``v -= factor w``."""
+    for i in range(v.size):
+        v[i] -= factor * w[i]
