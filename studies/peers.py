@@ -87,7 +87,8 @@ class Evaluator:
         p[...] = pressure_field[problem.local_rows] / problem.pressure_scale
         problem.operator.displacement(self.pressure, self.work)
         gap = problem.local(self.work) - problem.local(problem.heights, readonly=True)
-        gap += problem.contact_separation(self.pressure, gap)
+        separation = problem.contact_separation(self.pressure, gap)
+        gap += separation
         p = problem.local(self.pressure, readonly=True)
         kkt = report(problem.mpi, p, gap, problem.n, self.target)
         m = measure(problem, p, gap)
@@ -95,7 +96,7 @@ class Evaluator:
             "natural": kkt.natural, "load_error": kkt.load_error, "min_p": kkt.min_p, "min_g": kkt.min_g,
             "complementarity": kkt.complementarity,
             "A": m["A"], "gbar": m["gbar"] * problem.height_scale,
-            "separation": d * problem.height_scale, "n_contact": int(round(m["A"] * problem.n)),
+            "separation": separation * problem.height_scale, "n_contact": int(round(m["A"] * problem.n)),
         }
 
     def destroy(self):
