@@ -36,7 +36,7 @@ import numpy as np
 from .contact import Result, measure
 from .errors import ParameterError
 from .kkt import KKTReport, allmax, allmin, allsum
-from .solvers import cg_kernels as kernels
+from . import kernels
 from .solvers.gap_cg import gap_cg
 
 SOLVERS = ("gapcg", "almm")

@@ -21,6 +21,7 @@ preconditioning matrix with a free-set ``createSubMatrix`` and PC type
 import numpy as np
 from petsc4py import PETSc
 
+from . import kernels
 from .kkt import allsum
 
 # Weight w of the mean mode. Measured with PK under displacement control on
@@ -79,10 +80,8 @@ class FourierPreconditioner:
             np.multiply(contact, -residual_mean, out=out)
             out += residual  # P residual, built in out: the FFT pair may run in place
             operator.stiffness(out.reshape(shape), out.reshape(shape))
-        out *= contact
-        out_sum, = allsum(problem.mpi, [out.sum()])
-        out -= out_sum / count
-        out *= contact
+        out_sum, = allsum(problem.mpi, [kernels.masked_sum(out, contact)])
+        kernels.shift_on(out, contact, out_sum / count)
         if not keep_load:
             compliance = self.mean_mode_compliance(contact, count)
             if not np.isfinite(compliance):

@@ -23,7 +23,7 @@ lowest it saw (a copy is kept each time the residual halves, not at every iterat
 import numpy as np
 
 from ..kkt import STAGNATION_ITERATIONS, History, allsum
-from . import cg_kernels as kernels
+from .. import kernels
 from .protocol import Outcome
 
 REFRESH = 50  # recompute S g at least every REFRESH iterations (the update S g -= step S t drifts)

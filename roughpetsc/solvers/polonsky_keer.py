@@ -44,7 +44,7 @@ from petsc4py import PETSc
 from ..errors import UserError
 from ..kkt import STAGNATION_ITERATIONS, History, KKTReport, allmax, allsum
 from ..preconditioner import FourierPreconditioner
-from . import cg_kernels as kernels
+from .. import kernels
 from .tao_options import option_name
 
 PRECONDITIONERS = ("none", "fourier")
