@@ -25,6 +25,8 @@
 #                     7.19, 7.21): every second history step of the early stage (15 steps, p* <= 0.2) and
 #                     of the nearly-complete stage (10 steps, p* = 2.2 ... 4): a 1024^2 surface along 33
 #                     steps took ~670 s of wall per rank here, along 95 it would take ~30 min
+#   ch7             : groups 1-17 at 1024^2, 50 surfaces each (CH7_SIZE), the 33 steps (groups 3 and 4: the
+#                     steps their figures need, as below); not in the default stages: run it by name
 #   group 4         : not run by default (k_s = 512 is the Nyquist wavenumber of 1024^2, two nodes per
 #                     shortest wavelength; stage g04 runs 2 surfaces at 1024^2)
 # The 33 steps: every third step of (7.11) counted back from p* = 4 (indices 94, 91, ..., 1) plus
@@ -70,6 +72,12 @@ stage() {
         g18_2048|g22_2048|g23_2048|g27_2048)
                   g=${1%_2048}; g=${g#g}; v=G${g}_2048_SIZE
                   run "group${g}_N2048" "$g" 2048 "${!v:-2}" "$SUBSET" ;;
+        ch7)      # issue 14, item 3: chapter 7 at the dissertation's scale, 50 surfaces a group at 1024^2
+                  # (measured: a group-#1 surface along the 33 steps, 59 s on one core)
+                  for g in 01 02 03 04 05 06 07 08 09 10 11 12 13 14 15 16 17; do
+                      loads=$SUBSET; [[ $g == 03 || $g == 04 ]] && loads=$EARLY_LATE
+                      run "group${g}_N1024" "$g" 1024 "${CH7_SIZE:-50}" "$loads"
+                  done ;;
         extras)   echo "=== $(date +%H:%M:%S) extras" | tee -a "$OUT/logs/runs.log"
                   $PY studies/ensemble_figures.py --extras >>"$OUT/logs/extras.log" 2>&1 ;;
         *) echo "unknown stage $1" >&2; return 2 ;;
