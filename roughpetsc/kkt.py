@@ -65,18 +65,15 @@ def allmax(comm, values):
 
 
 @PETSc.Log.EventDecorator("RPKKTCheck")  # -log_view: the residual check of every iteration
-def report(comm, pressure, gap, n_total, target_pbar=None, upper=None, scratch=None, feasibility=True):
+def report(comm, pressure, gap, n_total, target_pbar=None, upper=None):
     """KKT report of local arrays ``pressure``, ``gap`` (scaled units, rms height 1).
 
     ``target_pbar`` is the prescribed mean pressure under load control (None
     under displacement control, where the solution's own mean is used).
     ``upper`` is the hardness cap in the same units (None: no upper bound).
-    ``scratch``: two float arrays of the local size, for a caller that reports every iteration (N^2
-    temporaries cost their page faults at each call). ``feasibility=False`` leaves ``min_p`` and
-    ``min_g`` out (NaN): an iteration's stopping test and monitor need neither.
     """
     pressure, gap = pressure.ravel(), gap.ravel()
-    residual, high = scratch if scratch is not None else (np.empty_like(pressure), np.empty_like(pressure))
+    residual, high = np.empty_like(pressure), np.empty_like(pressure)
     sum_p, sum_pg = allsum(comm, [pressure.sum(), np.dot(pressure, gap)])
     mean_p = sum_p / n_total
     scale = target_pbar if target_pbar else (mean_p if mean_p > 0 else 1.0)
@@ -91,20 +88,18 @@ def report(comm, pressure, gap, n_total, target_pbar=None, upper=None, scratch=N
     natural, = allmax(comm, [max(residual.max(initial=0.0), -residual.min(initial=0.0))])
     if upper is not None:
         # The capped nodes leave sum(p g) and min(g) through their mask in single passes: this runs every
-        # iteration of a capped solve, and numpy's reductions with where= are several times slower.
+        # iteration of a capped TAO solve, and numpy's reductions with where= are several times slower.
         at_cap = np.greater_equal(pressure, upper, out=high.view(np.bool_)[:pressure.size])
         capped_pg, = allsum(comm, [np.einsum("i,i,i->", at_cap, pressure, gap)])
         sum_pg -= capped_pg
-    min_p = min_g = np.nan
-    if feasibility:
-        if upper is None:
-            min_g_local = gap.min(initial=np.inf)
-        else:
-            lifted = np.multiply(at_cap, np.finfo(np.float64).max, out=residual)  # capped nodes out of min(g)
-            lifted += gap
-            min_g_local = lifted.min(initial=np.inf)
-        min_p, min_g = allmin(comm, [pressure.min(initial=np.inf), min_g_local])
-        min_p /= scale
+    if upper is None:
+        min_g_local = gap.min(initial=np.inf)
+    else:
+        lifted = np.multiply(at_cap, np.finfo(np.float64).max, out=residual)  # capped nodes out of min(g)
+        lifted += gap
+        min_g_local = lifted.min(initial=np.inf)
+    min_p, min_g = allmin(comm, [pressure.min(initial=np.inf), min_g_local])
+    min_p /= scale
     return KKTReport(
         natural=float(natural),
         complementarity=float(sum_pg / sum_p) if sum_p > 0 else 0.0,
