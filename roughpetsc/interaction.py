@@ -57,10 +57,11 @@ class Dugdale:
         """``phi(trial) - phi(gap)`` node by node, as sigma0 (min(trial, h0) - min(gap, h0)) (no w to cancel)."""
         return self.energy_changes_from(gap)(trial, np.empty_like(trial))
 
-    def energy_changes_from(self, gap):
+    def energy_changes_from(self, gap, scratch=None):
         """``change(trial, out)``: :meth:`energy_change` from ``gap`` written to ``out`` (which may be ``trial``),
-        the part of ``gap`` made once (a line search calls it for every trial step)."""
-        base = np.minimum(gap, self.range)
+        the part of ``gap`` made once (a line search calls it for every trial step); ``scratch``: two arrays
+        of gap's shape it may keep (allocated if None)."""
+        base = np.minimum(gap, self.range, out=None if scratch is None else scratch[0])
 
         def change(trial, out):
             np.minimum(trial, self.range, out=out)
@@ -111,11 +112,14 @@ class Exponential:
         """
         return self.energy_changes_from(gap)(trial, np.empty_like(trial))
 
-    def energy_changes_from(self, gap):
+    def energy_changes_from(self, gap, scratch=None):
         """``change(trial, out)``: :meth:`energy_change` from ``gap`` written to ``out`` (which may be ``trial``),
-        phi(gap) made once (a line search calls it for every trial step); one scratch array is kept."""
-        base = self.energy(gap)
-        above = np.empty_like(gap)
+        phi(gap) made once (a line search calls it for every trial step); ``scratch``: two arrays of gap's
+        shape it keeps (allocated if None)."""
+        base, above = scratch if scratch is not None else (np.empty_like(gap), np.empty_like(gap))
+        np.multiply(gap, -1.0 / self.range, out=base)
+        np.exp(base, out=base)
+        base *= -self.work  # phi(gap)
 
         def change(trial, out):  # out may be trial
             np.maximum(trial, 0.0, out=above)

@@ -77,13 +77,6 @@ def free_set(p, gap, contact, upper, overlapping):
 
 
 @njit(cache=True, fastmath={"reassoc"})
-def free_residual(gap, contact, mean, residual):
-    """``residual = (gap - mean)`` on the free set, 0 elsewhere."""
-    for i in range(gap.size):
-        residual[i] = (gap[i] - mean) * contact[i]
-
-
-@njit(cache=True, fastmath={"reassoc"})
 def conjugacy_sums(residual, direction, previous, t, contact, keep_previous):
     """Local ``(r'z, r_old'z, sum of t over F, sum of z)`` with z = ``direction``; ``previous = residual``
     afterwards when ``keep_previous`` (the Polak-Ribiere beta needs the last residual)."""
@@ -228,10 +221,10 @@ def masked_sum(v, mask):
 
 
 @njit(cache=True)
-def shift_on(v, mask, shift):
-    """``v = (v - shift)`` on the mask, 0 elsewhere."""
+def shift_on(v, mask, shift, out):
+    """``out = (v - shift)`` on the mask, 0 elsewhere (``out`` may be ``v``)."""
     for i in range(v.size):
-        v[i] = (v[i] - shift) * mask[i]
+        out[i] = (v[i] - shift) * mask[i]
 
 
 @njit(cache=True, fastmath={"reassoc"})

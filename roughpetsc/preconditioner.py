@@ -81,7 +81,7 @@ class FourierPreconditioner:
             out += residual  # P residual, built in out: the FFT pair may run in place
             operator.stiffness(out.reshape(shape), out.reshape(shape))
         out_sum, = allsum(problem.mpi, [kernels.masked_sum(out, contact)])
-        kernels.shift_on(out, contact, out_sum / count)
+        kernels.shift_on(out, contact, out_sum / count, out)
         if not keep_load:
             compliance = self.mean_mode_compliance(contact, count)
             if not np.isfinite(compliance):

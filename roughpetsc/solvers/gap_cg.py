@@ -73,6 +73,7 @@ class _Scratch:
         self.work = np.empty(size)
         self.free = np.empty(size)
         self.open = np.empty(size, dtype=bool)
+        self.law = (np.empty(size), np.empty(size))  # the line search's parts of phi (energy_changes_from)
         self.best = np.empty(size)  # an iterate near the lowest natural residual, returned by a stop short of it
 
 
@@ -125,7 +126,7 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
         # The free set: out of contact, and the contact nodes that pull (they open along the direction);
         # the residual on it, at zero mean there (directions keep the mean gap).
         count, total = allsum(mpi, kernels.gap_free_residual(r, lam, scratch.open, free, response))
-        kernels.shift_on(response, free, total / count)
+        kernels.shift_on(response, free, total / count, response)
         operator.displacement(response_vec, preconditioned_vec)
         _restrict(mpi, z, free, count)
         rz, r_old_z, t_free, z_sum = allsum(mpi, kernels.conjugacy_sums(response, z, r_old, t, free, True))
@@ -147,7 +148,8 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
         curvature = curvature_elastic + _law_curvature(law, mpi, g, t, work)
         if not curvature > 0:
             curvature = curvature_elastic
-        step = _armijo_step(adhesive, g, t, slope, curvature_elastic, elastic_slope, slope / curvature, work)
+        step = _armijo_step(adhesive, g, t, slope, curvature_elastic, elastic_slope, slope / curvature, work,
+                            scratch.law)
         if step is None:
             reason, stopped_by = "DIVERGED_LS_FAILURE", "no decrease of the energy along the direction"
             break
@@ -171,7 +173,7 @@ def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, 
 def _restrict(mpi, v, free, count):
     """``v`` restricted to the free set (a 0/1 float mask) and shifted to zero mean there (in place)."""
     total, = allsum(mpi, [kernels.masked_sum(v, free)])
-    kernels.shift_on(v, free, total / count)
+    kernels.shift_on(v, free, total / count, v)
 
 
 def _law_curvature(law, mpi, g, t, work):
@@ -197,17 +199,17 @@ def _feasible(mpi, t, r, open_nodes, open_count):
     return slope
 
 
-def _armijo_step(adhesive, g, t, slope, curvature_elastic, elastic_slope, step, trial):
+def _armijo_step(adhesive, g, t, slope, curvature_elastic, elastic_slope, step, trial, law_scratch):
     """The first of ``step``, step/2, ... along -t that decreases the energy enough (None if none does).
 
     The test is on the energy along the line before the projection (phi continued below g = 0 by its
     tangent, :meth:`energy_change` of the laws), whose slope at 0 is exactly ``slope``; the projection
     follows, as in Polonsky-Keer. The change is summed from node-wise changes, so it does not cancel near
     the solution: the elastic part is the quadratic -s <S(g + h), t> + s^2/2 <t, S t>, the law's part
-    sum (phi(g - s t) - phi(g)).
+    sum (phi(g - s t) - phi(g)). ``trial`` and the two arrays of ``law_scratch`` are scratch of g's size.
     """
     law, mpi = adhesive.scaled_law, adhesive.problem.mpi
-    changes = law.energy_changes_from(g)
+    changes = law.energy_changes_from(g, law_scratch)
     for _ in range(MAX_BACKTRACKS):
         np.multiply(t, -step, out=trial)
         trial += g

@@ -213,7 +213,7 @@ class PolonskyKeer:
             # Directions keep the load: under load control the residual has zero mean on the free set.
             mean = gap_sum / count if load_control and gap_sum else 0.0
             r = response
-            kernels.free_residual(gap, contact, mean, r)
+            kernels.shift_on(gap, contact, mean, r)
             if precondition:
                 self.fourier.apply(r, z, contact, count, keep_load=load_control)
                 direction = z
