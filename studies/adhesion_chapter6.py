@@ -1,11 +1,14 @@
-"""The adhesive adapted GW model (6.40)-(6.54) against adhesive BEM on surface group #1 (issue 15, item 4).
+"""The adhesive adapted GW model (6.40)-(6.54) against adhesive BEM on surface groups (issue 15, item 4).
 
-    .venv/bin/python studies/adhesion_chapter6.py [--n 512] [--seeds 1 2 3 4] [--ratios 20 50 100] [--pmax 2]
-                                                  [--pmin 1]
+    .venv/bin/python studies/adhesion_chapter6.py [--groups 1 2 18 22] [--n 512] [--seeds 1 2 3 4]
+                                                  [--ratios 20 50 100] [--pmax 2] [--pmin 1] [--report]
 
 The dissertation's section 6.6 uses a surface with m0^p* = 1e-4 (Table 6.2), which is group #1 of Table 7.1
-(m2^h = 2e-4, so m0^p = m2^h E*^2 / 2): we take group #1 (options/group01.opts, xu generator) at n^2,
-E* = 1, the Dugdale law with sigma0 / E* = 1/20, 1/50, 1/100 as in Figs 6.9-6.11.
+(m2^h = 2e-4, so m0^p = m2^h E*^2 / 2); every group preset has the same m2^h, so the same m0^p*, and differs
+in its bandwidths: group #2 (alpha^h 5.3) and the chapter 8 groups #18 (alpha^p 1.9) and #22 (2.3) test
+whether the model's agreement depends on them. Each group is generated as its ``options/groupNN.opts`` types
+it (the xu generator) at n^2, E* = 1, with the Dugdale law at sigma0 / E* = 1/20, 1/50, 1/100 as in Figs
+6.9-6.11.
 
 The range z0 is not printed (Table 6.2 lists the moments only). The choice: z0 = 0.33 sqrt(m0^h), the
 ratio of an interatomic distance of 0.3 nm to the rms height sqrt(8.35e-19 m^2) = 0.91 nm of Table 6.2,
@@ -16,10 +19,11 @@ BEM: displacement control, the mean gap decreasing along g* = 2 ... 1e-6 (geomet
 at which the gap closes cannot be imposed), then increasing back along the same gaps (unloading), each
 solve warm-started (the gap CG). The model is one of nearly complete contact: it is compared where
 p* >= ``--pmin``. The model: ``AdhesiveGW.loading(p*)`` and ``unloading(p*, p*_max)`` at the BEM's p*, with the
-surface's own moments. Both give 1 - A* and g*; the non-adhesive BEM (Polonsky-Keer) at the same loads
-is the reference the adhesion moves away from. Means over ``--seeds``.
+surface's own moments. Both give 1 - A* and g*. Means over ``--seeds``.
 
-Output: studies/output/adhesion/chapter6.md, chapter6.png.
+Resumable: each (group, n, sigma0, seed) cycle is kept in studies/output/adhesion/chapter6.json as it
+finishes, so a rerun adds only the missing ones. Output: studies/output/adhesion/chapter6.md and
+chapter6.png (one row of panels per group).
 """
 
 import argparse
@@ -32,8 +36,17 @@ import common
 Z0_OVER_RMS = 0.3 / np.sqrt(8.35e-19 * 1e18)  # 0.3 nm over the 0.91 nm rms height of Table 6.2
 
 
+def group_heights(grid, number, seed):
+    """A surface of group ``number`` as ``options/groupNN.opts`` types it (its generator included)."""
+    from roughpetsc import fractal, fractal_group
+
+    group = fractal_group(number)
+    del group["n"], group["length"]
+    return fractal(grid, **group, seed=seed)
+
+
 def bem_cycle(problem, law, pmax):
-    """(p*, 1 - A*, g*) along loading then unloading (arrays), and the number of steps loaded."""
+    """(p*, 1 - A*, g*, converged) along loading then unloading (rows), and the number of steps loaded."""
     from roughpetsc.adhesive import AdhesiveContact
 
     adhesive = AdhesiveContact(problem, law, rtol=1e-8)
@@ -52,91 +65,127 @@ def bem_cycle(problem, law, pmax):
             rows.append((result.pstar, 1 - result.A, result.gstar, result.converged))
     finally:
         adhesive.destroy()
-    return np.array(rows), loaded
+    return rows, loaded
+
+
+def run_cycle(n, number, ratio, seed, pmax):
+    """One BEM cycle and the model along it: a JSON-ready dict."""
+    from roughpetsc import ContactProblem, Grid, surface_moments
+    from roughpetsc.interaction import Dugdale
+    from roughpetsc.models.adhesion import AdhesiveGW
+
+    grid = Grid(n, n)
+    heights = group_heights(grid, number, seed)
+    problem = ContactProblem(grid, heights, 1.0)
+    try:
+        z0 = Z0_OVER_RMS * problem.sqrt_m0h
+        moments = surface_moments(grid, heights, 1.0)
+        model = AdhesiveGW(moments["m0h"], moments["m2h"], moments["m4h"], moments["m6h"], 1.0 / ratio, z0)
+        rows, loaded = bem_cycle(problem, Dugdale(z0 / ratio, 1.0 / ratio), pmax)  # w = sigma0 z0, E* = 1
+    finally:
+        problem.destroy()
+    pstars = np.array([row[0] for row in rows])
+    pmax_reached = pstars[loaded - 1]
+    loading = model.loading(pstars[:loaded])
+    unloading = model.unloading(np.minimum(pstars[loaded:], pmax_reached), pmax_reached)
+    model_rows = np.column_stack([np.concatenate([1 - loading[0], 1 - unloading[0]]),
+                                  np.concatenate([loading[1], unloading[1]])])
+    return {"group": number, "n": n, "ratio": ratio, "seed": seed, "pmax": pmax, "loaded": loaded,
+            "bem": [[float(v) for v in row] for row in rows],
+            "model": [[float(v) if np.isfinite(v) else None for v in row] for row in model_rows],
+            "alpha_h": float(moments["m0h"] * moments["m4h"] / moments["m2h"] ** 2)}
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--groups", type=int, nargs="+", default=[1, 2, 18, 22])
     parser.add_argument("--n", type=int, default=512)
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4])
     parser.add_argument("--ratios", type=float, nargs="+", default=[20.0, 50.0, 100.0])
     parser.add_argument("--pmax", type=float, default=2.0)
     parser.add_argument("--pmin", type=float, default=1.0, help="compare at p* >= this (nearly complete contact)")
-    args = parser.parse_args()
-    common.init()
+    out = os.path.join(common.OUTPUT, "adhesion")
+    args, path, cycles = common.start_resumable(parser, out, "chapter6", "only rewrite the report from the JSON")
+    key = ("group", "n", "ratio", "seed", "pmax")
+    done = {tuple(c[k] for k in key) for c in cycles}
+    if not args.report:
+        for number in args.groups:
+            for ratio in args.ratios:
+                for seed in args.seeds:
+                    if (number, args.n, ratio, seed, args.pmax) in done:
+                        continue
+                    cycle = run_cycle(args.n, number, ratio, seed, args.pmax)
+                    cycles.append(cycle)
+                    common.save_rows(path, cycles)
+                    converged = all(row[3] for row in cycle["bem"])
+                    print(f"group {number}, sigma0/E* = 1/{ratio:g}, seed {seed}: {len(cycle['bem'])} steps, "
+                          f"all converged: {converged}", flush=True)
+    report(args, [c for c in cycles if c["n"] == args.n and c["pmax"] == args.pmax
+                  and c["group"] in args.groups and c["ratio"] in args.ratios and c["seed"] in args.seeds], out)
+
+
+def group_means(cycles):
+    """The BEM and model rows averaged over the seeds (cut to the shortest cycle), and the steps loaded."""
+    steps = min(len(c["bem"]) for c in cycles)
+    loaded = min(c["loaded"] for c in cycles)
+    bem = np.mean([np.array(c["bem"])[:steps, :3] for c in cycles], axis=0)
+    model = np.mean([np.array(c["model"], dtype=float)[:steps] for c in cycles], axis=0)
+    return bem, model, loaded
+
+
+def report(args, cycles, out):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from roughpetsc import ContactProblem, Grid, surface_moments
-    from roughpetsc.interaction import Dugdale
-    from roughpetsc.models.adhesion import AdhesiveGW
-
-    grid = Grid(args.n, args.n)
-    figure, axes = plt.subplots(1, 2, figsize=(10, 4))
-    lines = ["# Adhesive adapted GW (6.40)-(6.54) against adhesive BEM, group #1", "",
-             f"Generated by `.venv/bin/python studies/adhesion_chapter6.py --n {args.n} --seeds "
-             f"{' '.join(map(str, args.seeds))} --ratios {' '.join(f'{r:g}' for r in args.ratios)} --pmax "
-             f"{args.pmax:g}` (set-up and the choice of z0 in its docstring). Differences model - BEM of 1 - A* "
-             "and g* (g* relative), at the BEM's p*, means over the seeds.", "",
-             "| sigma0/E* | stage | p* range compared | steps | max abs diff 1-A* | max rel diff g* | p* | BEM 1-A* "
-             "| model 1-A* | BEM g* | model g* |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    groups = [g for g in args.groups if any(c["group"] == g for c in cycles)]
+    lines = ["# Adhesive adapted GW (6.40)-(6.54) against adhesive BEM, groups "
+             + ", ".join(f"#{g}" for g in groups), "",
+             f"Generated by `.venv/bin/python studies/adhesion_chapter6.py --groups {' '.join(map(str, groups))} "
+             f"--n {args.n} --seeds {' '.join(map(str, args.seeds))} --ratios "
+             f"{' '.join(f'{r:g}' for r in args.ratios)} --pmax {args.pmax:g}` (set-up and the choice of z0 in its "
+             "docstring). Differences model - BEM of 1 - A* and g* (g* relative), at the BEM's p*, means over the "
+             f"seeds; compared where p* >= {args.pmin:g}.", "",
+             "| group | alpha^h | sigma0/E* | stage | seeds | all converged | p* range compared | steps "
+             "| max abs diff 1-A* | max rel diff g* | p* | BEM 1-A* | model 1-A* | BEM g* | model g* |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    figure, axes = plt.subplots(max(len(groups), 1), 2, figsize=(10, 4 * max(len(groups), 1)), squeeze=False)
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    for colour, ratio in zip(colours, args.ratios):
-        cycles, models = [], []
-        for seed in args.seeds:
-            heights = common.group1_heights(grid, seed)
-            problem = ContactProblem(grid, heights, 1.0)
-            z0 = Z0_OVER_RMS * problem.sqrt_m0h
-            law = Dugdale(z0 / ratio, 1.0 / ratio)  # w = sigma0 z0, E* = 1
-            moments = surface_moments(grid, heights, 1.0)
-            model = AdhesiveGW(moments["m0h"], moments["m2h"], moments["m4h"], moments["m6h"], 1.0 / ratio, z0)
-            cycle, loaded = bem_cycle(problem, law, args.pmax)
-            problem.destroy()
-            pstars = cycle[:, 0]
-            pmax_reached = pstars[loaded - 1]
-            loading = model.loading(pstars[:loaded])
-            unloading = model.unloading(np.minimum(pstars[loaded:], pmax_reached), pmax_reached)
-            model_rows = np.column_stack([np.concatenate([1 - loading[0], 1 - unloading[0]]),
-                                          np.concatenate([loading[1], unloading[1]])])
-            cycles.append((cycle, loaded))
-            models.append(model_rows)
-            print(f"sigma0/E* = 1/{ratio:g}, seed {seed}: {len(cycle)} steps, all converged: "
-                  f"{bool(cycle[:, 3].all())}", flush=True)
-        steps = min(len(c) for c, _ in cycles)
-        loaded = min(l for _, l in cycles)
-        bem = np.mean([c[:steps, :3] for c, _ in cycles], axis=0)
-        model = np.mean([m[:steps] for m in models], axis=0)
-        for stage, part in (("loading", slice(0, loaded)), ("unloading", slice(loaded, steps))):
-            b, m = bem[part], model[part]
-            valid = np.isfinite(m[:, 0]) & (b[:, 0] >= args.pmin)
-            if not valid.any():
+    for row_axes, number in zip(axes, groups):
+        for colour, ratio in zip(colours, args.ratios):
+            mine = [c for c in cycles if c["group"] == number and c["ratio"] == ratio]
+            if not mine:
                 continue
-            b, m = b[valid], m[valid]
-            top = int(np.argmax(b[:, 0]))
-            lines.append(f"| 1/{ratio:g} | {stage} | {b[:, 0].min():.3g} - {b[:, 0].max():.3g} | {len(b)} | "
-                         f"{np.abs(m[:, 0] - b[:, 1]).max():.4f} | {np.max(np.abs(m[:, 1] - b[:, 2]) / b[:, 2]):.2f} | "
-                         f"{b[top, 0]:.3g} | {b[top, 1]:.4f} | {m[top, 0]:.4f} | {b[top, 2]:.3g} | {m[top, 1]:.3g} |")
-        axes[0].plot(bem[:loaded, 0], bem[:loaded, 1], "o", color=colour, ms=3, label=f"BEM 1/{ratio:g}")
-        axes[0].plot(bem[loaded:, 0], bem[loaded:, 1], "s", color=colour, ms=3, mfc="none")
-        axes[0].plot(bem[:loaded, 0], model[:loaded, 0], "-", color=colour, label=f"model 1/{ratio:g}")
-        axes[0].plot(bem[loaded:, 0], model[loaded:, 0], "--", color=colour)
-        axes[1].plot(bem[:loaded, 0], bem[:loaded, 2], "o", color=colour, ms=3)
-        axes[1].plot(bem[loaded:, 0], bem[loaded:, 2], "s", color=colour, ms=3, mfc="none")
-        axes[1].plot(bem[:loaded, 0], model[:loaded, 1], "-", color=colour)
-        axes[1].plot(bem[loaded:, 0], model[loaded:, 1], "--", color=colour)
-    for axis, label in zip(axes, ("1 - A*", "g*")):
-        axis.set_xlabel("p*")
-        axis.set_ylabel(label)
-        axis.set_yscale("log")
-        axis.set_xlim(0.5, args.pmax * 1.05)
-    axes[0].legend(fontsize=7)
+            bem, model, loaded = group_means(mine)
+            converged = all(row[3] for c in mine for row in c["bem"])
+            alpha_h = np.mean([c["alpha_h"] for c in mine])
+            for stage, part in (("loading", slice(0, loaded)), ("unloading", slice(loaded, len(bem)))):
+                b, m = bem[part], model[part]
+                valid = np.isfinite(m[:, 0]) & (b[:, 0] >= args.pmin)
+                if not valid.any():
+                    continue
+                b, m = b[valid], m[valid]
+                top = int(np.argmax(b[:, 0]))
+                lines.append(
+                    f"| {number} | {alpha_h:.2f} | 1/{ratio:g} | {stage} | {len(mine)} | {converged} | "
+                    f"{b[:, 0].min():.3g} - {b[:, 0].max():.3g} | {len(b)} | {np.abs(m[:, 0] - b[:, 1]).max():.4f} | "
+                    f"{np.max(np.abs(m[:, 1] - b[:, 2]) / b[:, 2]):.2f} | {b[top, 0]:.3g} | {b[top, 1]:.4f} | "
+                    f"{m[top, 0]:.4f} | {b[top, 2]:.3g} | {m[top, 1]:.3g} |")
+            for axis, column, model_column in ((row_axes[0], 1, 0), (row_axes[1], 2, 1)):
+                axis.plot(bem[:loaded, 0], bem[:loaded, column], "o", color=colour, ms=3,
+                          label=f"BEM 1/{ratio:g}")
+                axis.plot(bem[loaded:, 0], bem[loaded:, column], "s", color=colour, ms=3, mfc="none")
+                axis.plot(bem[:loaded, 0], model[:loaded, model_column], "-", color=colour,
+                          label=f"model 1/{ratio:g}")
+                axis.plot(bem[loaded:, 0], model[loaded:, model_column], "--", color=colour)
+        for axis, label in zip(row_axes, ("1 - A*", "g*")):
+            axis.set(xlabel="p*", ylabel=label, yscale="log", xlim=(0.5, args.pmax * 1.05),
+                     title=f"group #{number}")
+        row_axes[0].legend(fontsize=7)
     figure.suptitle("loading: filled marks, solid lines; unloading: open marks, dashed lines", fontsize=9)
     figure.tight_layout()
-    out = os.path.join(common.OUTPUT, "adhesion")
-    os.makedirs(out, exist_ok=True)
-    figure.savefig(os.path.join(out, "chapter6.png"), dpi=120)
+    figure.savefig(os.path.join(out, "chapter6.png"), dpi=110)
     with open(os.path.join(out, "chapter6.md"), "w") as f:
         f.write("\n".join(lines) + "\n\n![1 - A* and g* against p*](chapter6.png)\n")
 
