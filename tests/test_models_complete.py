@@ -120,3 +120,32 @@ def test_curvefit_area_shape():
     A = M.curvefit_area(p, 2.17, b, c, d)
     I = M.complete("greenwood", p, 2.17, 2.17)[0]
     assert A[0] == 0 and np.all(np.diff(A) > 0) and A[-1] == I[-1]
+
+
+@pytest.mark.parametrize("alpha_p", [2.0, 4.33])
+def test_slope_held_fit_recovers_a_curve_with_the_bgt_slope(alpha_p):
+    """A curve I f whose (b, d) satisfy I(0) c (d - b) = sqrt(pi/2), built here by bisection on d, is fitted
+    back with the slope held; the fitted curve's slope at 0, by finite differences, is sqrt(pi/2)."""
+    from scipy.optimize import bisect
+
+    b = -2.6
+    I0 = M.complete("greenwood", [0.0], alpha_p, alpha_p)[0][0]
+    d = bisect(lambda d: I0 * (d - b) / (np.exp(2 * d) - np.exp(2 * b)) - np.sqrt(np.pi / 2), b + 1e-6, 5.0,
+               xtol=1e-15)
+    c = 1 / (np.exp(2 * d) - np.exp(2 * b))
+    p = np.linspace(0, 4, 65)
+    bf, cf, df = M.fit_curvefit(p, M.curvefit_area(p, alpha_p, b, c, d), alpha_p, guess=(-1.9, -0.05),
+                                slope=M.BGT_SLOPE)
+    assert abs(bf - b) < 1e-7 and abs(df - d) < 1e-6 and abs(cf - c) < 1e-6
+    h = 1e-7
+    slope = (M.curvefit_area([h], alpha_p, bf, cf, df)[0] - M.curvefit_area([0.0], alpha_p, bf, cf, df)[0]) / h
+    assert slope == pytest.approx(np.sqrt(np.pi / 2), rel=1e-5)
+
+
+def test_bootstrap_of_identical_surfaces_has_no_spread():
+    b, c, d = M.TABLE_8_4[18]
+    p = np.linspace(0, 4, 33)
+    curve = M.curvefit_area(p, 2.0, b, 1 / (np.exp(2 * d) - np.exp(2 * b)), d)
+    fit, draws = M.bootstrap_curvefit(p, np.tile(curve, (5, 1)), 2.0, resamples=4)
+    assert draws.shape == (4, 3) and np.allclose(draws, fit, atol=1e-7)
+    assert abs(fit[0] - b) < 1e-7 and abs(fit[2] - d) < 1e-7

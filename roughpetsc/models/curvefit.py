@@ -5,14 +5,19 @@ nearly-complete model (5.45) and f(p*) = a exp(b p*) + c exp(d p*) with a = -c
 (so that A*(0) = 0; erratum of docs/conventions.md: the sentence after Table 8.4 gives the column
 means of b, c, d under the names a, b, c).  Continuity at p* = 2 requires
 c = 1 / (exp(2 d) - exp(2 b)).
+
+Section 8.5 notes that the slope of the fit at p* = 0 should be the asymptotic BGT model's sqrt(pi/2), and
+that (8.3) with two free parameters does not hold it. Held as a third condition, I(0) c (d - b) = sqrt(pi/2)
+fixes d for each b (``slope=`` of :func:`fit_curvefit`), leaving one free parameter.
 """
 
 import numpy as np
-from scipy.optimize import least_squares
+from scipy.optimize import brentq, least_squares
 
 from .complete import complete
 
-__all__ = ["TABLE_8_4", "ALPHA_P_TABLE_8_3", "correction", "curvefit_area", "fit_curvefit"]
+__all__ = ["TABLE_8_4", "ALPHA_P_TABLE_8_3", "BGT_SLOPE", "correction", "curvefit_area", "fit_curvefit",
+           "bootstrap_curvefit"]
 
 #: Table 8.4: group -> (b, c, d); a = -c.
 TABLE_8_4 = {18: (-1.923, 1.160, -0.062), 19: (-1.924, 1.150, -0.058),
@@ -25,6 +30,8 @@ ALPHA_P_TABLE_8_3 = {18: 2.00, 19: 2.08, 20: 2.17, 21: 2.27, 22: 2.38,
                      23: 2.10, 24: 2.25, 25: 2.46, 26: 2.73, 27: 3.10}
 
 P_SPLIT = 2.0
+#: dA*/dp* of the asymptotic BGT model at p* -> 0 (section 8.5).
+BGT_SLOPE = float(np.sqrt(np.pi / 2))
 
 
 def correction(pstar, b, c, d):
@@ -55,12 +62,42 @@ def curvefit_area(pstar, alpha_p, b, c, d):
     return np.where(p <= P_SPLIT, I * correction(p, b, c, d), I)
 
 
-def fit_curvefit(pstar, area, alpha_p, guess=(-1.9, -0.05)):
+def _continuity_c(b, d):
+    """c of (8.3) with a = -c and f(2) = 1."""
+    return 1.0 / (np.exp(P_SPLIT * d) - np.exp(P_SPLIT * b))
+
+
+def _d_for_slope(b, slope, I0):
+    """The d != b at which the fit's slope at p* = 0, I(0) c (d - b), equals ``slope``.
+
+    ``(d - b) / (exp(2d) - exp(2b))`` is the reciprocal of the mean of ``2 exp(2x)`` over [b, d], so it
+    falls from +inf (d -> -inf) to 0 (d -> +inf): one root for every b.
+    """
+    target = slope / I0
+
+    def excess(d):
+        return (d - b) / np.expm1(P_SPLIT * (d - b)) * np.exp(-P_SPLIT * b) - target
+
+    limit = np.exp(-P_SPLIT * b) / P_SPLIT  # the value at d = b
+    if abs(limit - target) < 1e-14 * target:
+        return b + 1e-9
+    if limit > target:  # the root lies above b
+        return brentq(excess, b + 1e-12, b + 200.0, xtol=1e-14)
+    return brentq(excess, b - 200.0, b - 1e-12, xtol=1e-14)
+
+
+def fit_curvefit(pstar, area, alpha_p, guess=(-1.9, -0.05), slope=None):
     """Fit b, c, d of (8.2)-(8.3) to a curve A*(p*) (e.g. a BEM ensemble mean).
 
     The dissertation's two boundary conditions are built in: a = -c (A*(0) = 0) and
     c = 1 / (exp(2d) - exp(2b)) (continuity at p* = 2); b and d are found by
     least squares over the points with p* <= 2.
+
+    Parameters
+    ----------
+    slope : float, optional
+        If given (for example :data:`BGT_SLOPE`), dA*/dp* at p* = 0, I(0) c (d - b), is held at it: d
+        follows from b, and b alone is fitted. Of the two exponents the one nearer zero is returned as d.
 
     Returns
     -------
@@ -73,14 +110,47 @@ def fit_curvefit(pstar, area, alpha_p, guess=(-1.9, -0.05)):
         raise ValueError("need at least three points with p* <= 2 to fit b and d")
     p, A = p[sel], A[sel]
     I = complete("greenwood", p, alpha_p, alpha_p)[0]
+    if slope is None:
+        def exponents(x):
+            return x[0], x[1]
+        start = np.asarray(guess, float)
+    else:
+        I0 = float(complete("greenwood", np.zeros(1), alpha_p, alpha_p)[0][0])
 
-    def c_of(b, d):
-        return 1.0 / (np.exp(2 * d) - np.exp(2 * b))
+        def exponents(x):
+            return x[0], _d_for_slope(x[0], slope, I0)
+        start = np.asarray(guess[:1], float)
 
     def residual(x):
-        return I * correction(p, x[0], c_of(*x), x[1]) - A
+        b, d = exponents(x)
+        return I * correction(p, b, _continuity_c(b, d), d) - A
 
-    sol = least_squares(residual, np.asarray(guess, float), x_scale=1.0,
-                        xtol=1e-14, ftol=1e-14, gtol=1e-14)
-    b, d = sol.x
-    return float(b), float(c_of(b, d)), float(d)
+    sol = least_squares(residual, start, x_scale=1.0, xtol=1e-14, ftol=1e-14, gtol=1e-14)
+    b, d = sorted(exponents(sol.x))
+    return float(b), float(_continuity_c(b, d)), float(d)
+
+
+def bootstrap_curvefit(pstar, samples, alpha_p, resamples=400, seed=0, slope=None):
+    """The fit of :func:`fit_curvefit` to the mean of ``samples`` and its spread over the surfaces.
+
+    Parameters
+    ----------
+    pstar : (steps,) array_like
+        The load steps (p*) shared by every surface.
+    samples : (surfaces, steps) array_like
+        A* of each surface of an ensemble at each step.
+    resamples : int
+        Bootstrap resamples: surfaces drawn with replacement, their mean fitted again.
+
+    Returns
+    -------
+    fit : (b, c, d) of the ensemble mean
+    draws : (resamples, 3) ndarray of the refits (percentiles of its columns are confidence intervals)
+    """
+    samples = np.asarray(samples, dtype=float)
+    fit = fit_curvefit(pstar, samples.mean(axis=0), alpha_p, slope=slope)
+    rng = np.random.default_rng(seed)
+    guess = (fit[0], fit[2])
+    draws = np.array([fit_curvefit(pstar, samples[rng.integers(0, len(samples), len(samples))].mean(axis=0),
+                                   alpha_p, guess=guess, slope=slope) for _ in range(resamples)])
+    return fit, draws
