@@ -81,9 +81,15 @@ def _d_for_slope(b, slope, I0):
     limit = np.exp(-P_SPLIT * b) / P_SPLIT  # the value at d = b
     if abs(limit - target) < 1e-14 * target:
         return b + 1e-9
-    if limit > target:  # the root lies above b
-        return brentq(excess, b + 1e-12, b + 200.0, xtol=1e-14)
-    return brentq(excess, b - 200.0, b - 1e-12, xtol=1e-14)
+    if limit > target:  # the root lies above b, where the excess falls to -target
+        step = 1.0
+        while excess(b + step) > 0:
+            step *= 2
+        return brentq(excess, b + 1e-12, b + step, xtol=1e-14)
+    step = 1.0  # the root lies below b, where the excess grows like |d - b| exp(-2b)
+    while excess(b - step) < 0:
+        step *= 2
+    return brentq(excess, b - step, b - 1e-12, xtol=1e-14)
 
 
 def fit_curvefit(pstar, area, alpha_p, guess=(-1.9, -0.05), slope=None):
