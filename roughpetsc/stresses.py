@@ -77,7 +77,7 @@ def uniform_state(mean_pressure, nu):
 
 
 def von_mises(s):
-    """The von Mises equivalent stress of the components in dict ``s`` (C-contiguous arrays of one shape).
+    """The von Mises equivalent stress of the components in dict ``s`` (arrays of one shape).
 
     ``sqrt(3 (sum of the squared normal differences / 6 + sum of the squared shears))``.
     """
@@ -86,8 +86,9 @@ def von_mises(s):
 
 def _von_mises_and_where_largest(s):
     """The von Mises stress of dict ``s`` and the (row, column) of its largest value."""
-    equivalent = np.empty_like(s["xx"])
-    where = _von_mises_and_maximum(*(s[name].reshape(-1) for name in COMPONENTS), equivalent.reshape(-1))
+    equivalent = np.empty(np.shape(s["xx"]))
+    flat = (np.ascontiguousarray(s[name], dtype=float).reshape(-1) for name in COMPONENTS)
+    where = _von_mises_and_maximum(*flat, equivalent.reshape(-1))
     return equivalent, tuple(int(i) for i in np.unravel_index(where, equivalent.shape))
 
 

@@ -60,10 +60,13 @@ def test_max_shear_of_a_diagonal_state():
     assert max_shear(s)[0] == pytest.approx(1.4)
 
 
-def test_von_mises_from_the_principal_stresses():
-    """The blocked ufunc form against sqrt(((s1 - s2)^2 + (s2 - s3)^2 + (s3 - s1)^2) / 2) of the eigenvalues."""
+@pytest.mark.parametrize("layout", ["C", "F", "strided"])
+def test_von_mises_from_the_principal_stresses(layout):
+    """The compiled form against sqrt(((s1 - s2)^2 + (s2 - s3)^2 + (s3 - s1)^2) / 2) of the eigenvalues, for
+    components in any memory layout."""
     rng = np.random.default_rng(3)
-    s = {name: rng.standard_normal((70, 5)) for name in ("xx", "yy", "zz", "xy", "yz", "xz")}
+    arrange = {"C": np.ascontiguousarray, "F": np.asfortranarray, "strided": lambda a: np.repeat(a, 2, 0)[::2]}
+    s = {name: arrange[layout](rng.standard_normal((70, 5))) for name in ("xx", "yy", "zz", "xy", "yz", "xz")}
     tensor = np.stack([np.stack([s["xx"], s["xy"], s["xz"]], -1), np.stack([s["xy"], s["yy"], s["yz"]], -1),
                        np.stack([s["xz"], s["yz"], s["zz"]], -1)], -2)
     s1, s2, s3 = np.moveaxis(np.linalg.eigvalsh(tensor), -1, 0)
