@@ -7,8 +7,8 @@ ensemble files store (:class:`ensemble_common.Ens`).
 import numpy as np
 
 from ensemble_common import (DISSERTATION_FIG_3_9_A, DISSERTATION_TABLE_7_7, EARLY_PMAX, FIELD_GROUP, FIELD_N,
-                             GROUPS_7, LABEL, STYLE, M, bem, early_curve, panel_figures, plt, preferred, read_fields,
-                             save, title)
+                             GROUPS_7, LABEL, STYLE, M, bem, early_curve, fractal_group, nodes_per_wavelength,
+                             panel_figures, plt, preferred, read_fields, save, title)
 
 
 def fig_3_8_to_3_10(ensembles, produced, report):
@@ -179,16 +179,18 @@ def fig_7_complete(ensembles, produced):
 
 
 def table_7_7(ensembles, report):
+    read = [e for (g, _), e in sorted(ensembles.items()) if g in GROUPS_7]
+    nodes = "; ".join(f"group {e.group} at {e.N}^2: {nodes_per_wavelength(e):g}" for e in read) or "no file read"
+    presets = {g: fractal_group(g) for g in sorted(DISSERTATION_TABLE_7_7)}
+    theirs = ", ".join(f"{s['n'] / (s['k_s'] * s['length']):g} for group {g} at {s['n']}^2" for g, s in presets.items())
     report += ["## Table 7.7: bandwidth parameters (mean ± std over the surfaces)", "",
                "Ours from the spectral moments of each surface (what `-mode ensemble` stores and what the models "
                "above use) and from the dissertation's finite differences (7.6)/(7.7) (the dissertation's \"Num\"); "
                "closed forms "
                "(2.25)/(2.59) of the continuous PSD.", "",
                "The dissertation prints the same std (0.2144) for alpha^h and alpha^p of group 1, probably a copy "
-               "slip. Our "
-               "spectral values agree with the closed forms; the FD values depend on the grid (at 512^2 there are only "
-               "8 and 4 nodes per 1/k_s for groups 1 and 2, the dissertation had 16 and 8), so they exceed the "
-               "dissertation's.", "",
+               "slip. The FD values depend on the grid, through the nodes per shortest wavelength 1/k_s (ours: "
+               f"{nodes}; the dissertation's: {theirs}).", "",
                "| group | grid, surfaces | alpha^h ours (spectral) | alpha^h ours (FD) | alpha^h closed form | "
                "alpha^h dissertation | alpha^p ours (spectral) | alpha^p ours (FD) | alpha^p closed form | alpha^p "
                "dissertation |",

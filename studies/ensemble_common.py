@@ -18,7 +18,7 @@ import numpy as np  # noqa: E402
 
 import roughpetsc.models as M  # noqa: E402
 from roughpetsc import ensemble  # noqa: E402
-from roughpetsc.presets import ROOT, fractal_groups  # noqa: E402
+from roughpetsc.presets import ROOT, fractal_group, fractal_groups  # noqa: E402
 
 OUT = os.environ.get("ROUGHPETSC_ENSEMBLE_DIR", os.path.join(ROOT, "studies", "output", "ensembles"))
 EXTRAS = os.path.join(OUT, "extras.h5")
@@ -34,7 +34,11 @@ def group_table(numbers):
 
 
 GROUPS_7 = group_table(range(1, 5))      # the ensembles of chapter 7 (Table 7.1)
-GROUPS_8 = group_table(range(18, 28))    # the ensembles of chapter 8 (Table 8.1)
+GROUPS_8 = group_table(range(18, 28))    # the ensembles of chapter 8 (Table 8.1): the dissertation's 10 groups
+# Ours, beyond the dissertation's alpha^p < 3 (options/group28.opts ... group30.opts; issue 14, item 4)
+OUR_GROUPS_8 = group_table([number for number in range(28, 31) if number in fractal_groups()])
+# The column means of Table 8.4 the dissertation prints after it (names corrected): b, c, d
+DISSERTATION_TABLE_8_4_MEANS = (-1.913, 1.130, -0.049)
 DISSERTATION_FIG_3_9_A = (0.0379, 0.4644, 0.7243, 0.8919)      # the contact ratios of Figs. 3.9/3.10
 TOLERANCE = 0.02                                       # the project's acceptance target: A* within 0.02 of I f
 P_RANGE = (0.05, 4.0)
@@ -121,8 +125,7 @@ def load_ensembles():
 
 
 def preferred(ensembles, group):
-    """The ensemble of a group to plot: the one with the dissertation's grid if present and >= 4 surfaces, else the
-    one with the most surfaces (ties: the finer grid)."""
+    """The ensemble of a group to plot: the one with the most surfaces (ties: the finer grid), or None."""
     found = [e for (g, _), e in ensembles.items() if g == group]
     if not found:
         return None
@@ -275,9 +278,48 @@ def preferred_n(ensembles, group, n):
     return ensembles.get((group, n))
 
 
+def preset_grid(group):
+    """The grid (nodes per side) options/groupNN.opts names for a group: the dissertation's, for its groups; or None."""
+    try:
+        return fractal_group(group)["n"]
+    except ValueError:
+        return None
+
+
+def dissertation_grid(ensembles, group):
+    """The ensemble of a group on the grid its preset names (:func:`preset_grid`) if present, else the one with the
+    most surfaces (ties: the finer grid), else None."""
+    found = {n: e for (g, n), e in ensembles.items() if g == group}
+    if not found:
+        return None
+    n = preset_grid(group)
+    if n in found:
+        return found[n]
+    return max(found.values(), key=lambda e: (e.n, e.N))
+
+
+def nodes_per_wavelength(e):
+    """Nodes per shortest wavelength 1/k_s of an ensemble's surfaces."""
+    return e.N / (e.surface["ks"] * e.surface.get("L", 1.0))
+
+
+def describe(ens):
+    """``#18: 1024^2, 50 surfaces; ...`` of a list of ensembles, an unfinished one marked with its planned size, one off
+    the grid of its preset (options/groupNN.opts) with that grid."""
+    out = []
+    for e in ens:
+        text = f"#{e.group}: {e.N}^2, {e.n}" + ("" if e.complete else f" of {e.size}") + " surfaces"
+        n = preset_grid(e.group)
+        if n is not None and n != e.N:
+            text += f" (not its preset's {n}^2)"
+        out.append(text)
+    return "; ".join(out)
+
+
 def dissertation_curve(p, group, alpha_p):
-    """The dissertation's curve fit I(p*) f(p*) (8.2)-(8.3) of a group of Table 8.4 at bandwidth alpha_p."""
-    b, c, d = M.TABLE_8_4[group]
+    """The dissertation's curve fit I(p*) f(p*) (8.2)-(8.3) of a group of Table 8.4 at bandwidth alpha_p; a group not
+    in Table 8.4 (ours, 28-30) gets the column means the dissertation prints after it."""
+    b, c, d = M.TABLE_8_4.get(group, DISSERTATION_TABLE_8_4_MEANS)
     return M.curvefit_area(p, alpha_p, b, c, d)
 
 
