@@ -21,53 +21,56 @@ from .fftw import planner_effort
 COMPONENTS = ("xx", "yy", "zz", "xy", "yz", "xz")
 
 
-@njit(cache=True, error_model="numpy")
-def periodic_transfers(source, k0, k1, depth, nu, zero_mode, out):
-    """The six spectra of the stresses at ``depth``, ``out[c] = transfer_c * source``, in one sweep, (3.26).
+@njit(cache=True)
+def depth_decay(k0, k1, depth, kz, decay):
+    """``kz = 2 pi |k| z`` and ``decay = exp(-kz)`` on the half spectrum of wavenumbers ``(k0, k1)``.
 
-    ``source`` is the pressure's half spectrum (already divided by the node count), ``k0`` (rows, ``y``,
-    as :func:`numpy.fft.fftfreq` orders them) and ``k1`` (columns, ``x``) its wavenumbers in cycles per
-    length, ``out`` a tuple of six complex arrays of its shape in the order of :data:`COMPONENTS`. With
-    ``kz = 2 pi |k| z``, ``decay = exp(-kz)``, ``c_ij = k_i k_j / |k|^2`` and ``w = decay (kz - (1 - 2 nu))``:
-    ``sigma_xx = c_xx w - 2 nu decay``, ``sigma_yy = c_yy w - 2 nu decay``, ``sigma_xy = c_xy w``,
-    ``sigma_zz = -(1 + kz) decay`` (for ``k != 0``, where ``c_xx + c_yy = 1``) and the shear ones
-    ``2 pi i k_{x,y} z decay``. The zero mode of each spectrum is ``zero_mode[c]``, which the unnormalised
-    inverse adds to every node (module docstring). The rows of ``ky`` and ``-ky`` share their exponentials.
+    ``k0`` (rows, ``y``, as :func:`numpy.fft.fftfreq` orders them) and ``k1`` (columns, ``x``) in cycles per
+    length; the rows of ``ky`` and ``-ky`` share their exponentials.
     """
-    rows, columns = source.shape
-    kz = np.empty(columns)
-    decay = np.empty(columns)
+    rows, columns = kz.shape
     for row in range(rows):
-        if row > rows // 2 and k0[rows - row] == -k0[row]:
-            continue  # done with its mirror
-        for j in range(columns):
-            kz[j] = 2.0 * np.pi * np.sqrt(k1[j] * k1[j] + k0[row] * k0[row]) * depth
-            decay[j] = np.exp(-kz[j])
-        _transfer_row(source, k0, k1, row, kz, decay, depth, nu, out)
         mirror = rows - row
-        if 0 < row <= rows // 2 and mirror != row and k0[mirror] == -k0[row]:
-            _transfer_row(source, k0, k1, mirror, kz, decay, depth, nu, out)
-    for c in range(6):
-        out[c][0, 0] = zero_mode[c]
+        if row > rows // 2 and k0[mirror] == -k0[row]:
+            kz[row] = kz[mirror]
+            decay[row] = decay[mirror]
+            continue
+        for j in range(columns):
+            kz[row, j] = 2.0 * np.pi * np.sqrt(k1[j] * k1[j] + k0[row] * k0[row]) * depth
+            decay[row, j] = np.exp(-kz[row, j])
 
 
 @njit(cache=True, error_model="numpy")
-def _transfer_row(source, k0, k1, row, kz, decay, depth, nu, out):
-    """Row ``row`` of :func:`periodic_transfers`, from its ``kz`` and ``decay``."""
-    xx, yy, zz, xy, yz, xz = out
-    ky = k0[row]
-    for j in range(source.shape[1]):
-        kx = k1[j]
-        s = source[row, j]
-        w = decay[j] * (kz[j] - (1.0 - 2.0 * nu)) / (kx * kx + ky * ky)
-        scaled = 2.0 * nu * decay[j]
-        xx[row, j] = s * (kx * kx * w - scaled)
-        yy[row, j] = s * (ky * ky * w - scaled)
-        xy[row, j] = s * (kx * ky * w)
-        zz[row, j] = s * (-(1.0 + kz[j]) * decay[j])
-        shear = 1j * s * (2.0 * np.pi * depth * decay[j])
-        yz[row, j] = shear * ky
-        xz[row, j] = shear * kx
+def periodic_transfer(source, k0, k1, kz, decay, depth, nu, component, zero_mode, out):
+    """``out = transfer * source``: the spectrum of stress ``COMPONENTS[component]`` at ``depth``, (3.26).
+
+    ``source`` is the pressure's half spectrum (already divided by the node count), ``kz`` and ``decay``
+    those of :func:`depth_decay`. With ``c_ij = k_i k_j / |k|^2`` and ``w = decay (kz - (1 - 2 nu))``:
+    ``sigma_xx = c_xx w - 2 nu decay``, ``sigma_yy = c_yy w - 2 nu decay``, ``sigma_zz = -(1 + kz) decay``,
+    ``sigma_xy = c_xy w`` (for ``k != 0``, where ``c_xx + c_yy = 1``) and the shear ones
+    ``2 pi i k_{y,x} z decay``. The zero mode is ``zero_mode``, which the unnormalised inverse adds to every
+    node (module docstring).
+    """
+    compliance = 1.0 - 2.0 * nu
+    for row in range(source.shape[0]):
+        ky = k0[row]
+        for j in range(source.shape[1]):
+            kx = k1[j]
+            s = source[row, j]
+            d = decay[row, j]
+            if component < 2 or component == 3:
+                w = d * (kz[row, j] - compliance) / (kx * kx + ky * ky)
+                if component == 0:
+                    out[row, j] = s * (kx * kx * w - 2.0 * nu * d)
+                elif component == 1:
+                    out[row, j] = s * (ky * ky * w - 2.0 * nu * d)
+                else:
+                    out[row, j] = s * (kx * ky * w)
+            elif component == 2:
+                out[row, j] = s * (-(1.0 + kz[row, j]) * d)
+            else:
+                out[row, j] = 1j * s * (2.0 * np.pi * depth * d * (ky if component == 4 else kx))
+    out[0, 0] = zero_mode
 
 
 def uniform_state(mean_pressure, nu):
@@ -200,24 +203,23 @@ def periodic_stresses(pressure, lengths, depths, nu, effort="FFTW_MEASURE"):
     (real) inverse transforms per depth are the floor of the method (about two operator applications,
     measured by ``studies/free_hardness.py``).
     """
-    import pyfftw
-
     depths = check_depths(depths)
     check_poisson(nu)
     n0, n1 = pressure.shape
     real, spectrum, forward, backward = fft_pair((n0, n1), effort)
     real[...] = pressure
     forward.execute()
-    spectrum /= n0 * n1  # the unnormalised pair's 1 / (n0 n1)
+    source = spectrum / (n0 * n1)  # the unnormalised pair's 1 / (n0 n1); spectrum is each component's in turn
     k0 = np.fft.fftfreq(n0, d=lengths[0] / n0)
     k1 = np.fft.rfftfreq(n1, d=lengths[1] / n1)
     uniform = uniform_state(float(pressure.mean()), nu)
-    zero_mode = np.array([uniform[name] for name in COMPONENTS])
-    spectra = tuple(pyfftw.empty_aligned(spectrum.shape, dtype="complex128") for _ in COMPONENTS)
+    kz, decay = np.empty(source.shape), np.empty(source.shape)
     for depth in depths:
-        periodic_transfers(spectrum, k0, k1, depth, nu, zero_mode, spectra)
-        components = {name: _inverse_into_new_array(backward, transfer)
-                      for name, transfer in zip(COMPONENTS, spectra)}
+        depth_decay(k0, k1, depth, kz, decay)
+        components = {}
+        for index, name in enumerate(COMPONENTS):
+            periodic_transfer(source, k0, k1, kz, decay, depth, nu, index, uniform[name], spectrum)
+            components[name] = _inverse_into_new_array(backward, spectrum)
         yield _depth_result(depth, components)
 
 
