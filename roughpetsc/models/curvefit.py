@@ -97,13 +97,14 @@ def fit_curvefit(pstar, area, alpha_p, guess=(-1.9, -0.05), slope=None):
 
     The dissertation's two boundary conditions are built in: a = -c (A*(0) = 0) and
     c = 1 / (exp(2d) - exp(2b)) (continuity at p* = 2); b and d are found by
-    least squares over the points with p* <= 2.
+    least squares over the points with p* <= 2. Swapping b and d flips the sign of c and leaves f, so the
+    larger exponent is returned as d.
 
     Parameters
     ----------
     slope : float, optional
         If given (for example :data:`BGT_SLOPE`), dA*/dp* at p* = 0, I(0) c (d - b), is held at it: d
-        follows from b, and b alone is fitted. Of the two exponents the one nearer zero is returned as d.
+        follows from b, and b alone is fitted.
 
     Returns
     -------
