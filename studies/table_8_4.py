@@ -25,7 +25,6 @@ import os
 import numpy as np
 
 from ensemble_common import OUT as ENSEMBLES, load_ensembles, plt
-from roughpetsc import ensemble
 from roughpetsc.models.curvefit import ALPHA_P_TABLE_8_3, BGT_SLOPE, TABLE_8_4, bootstrap_curvefit, curvefit_area
 
 OUT = os.path.join(os.path.dirname(ENSEMBLES), "table_8_4")
@@ -36,8 +35,7 @@ KINDS = ("node count", "corrected", "slope")
 
 def per_surface_areas(e):
     """(node count, perimeter-corrected) A* of each surface at each step, (surfaces, steps) each."""
-    d = ensemble.read(e.path)
-    corrected = np.asarray(d["steps/A_corrected"], float).reshape(e.n, e.p.size)
+    corrected = np.asarray(e.d["steps/A_corrected"], float).reshape(e.n, e.p.size)
     return e.A_all, corrected
 
 
