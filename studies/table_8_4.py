@@ -17,6 +17,13 @@ Confidence intervals: 95 % percentiles of the bootstrap over the surfaces (``--r
 surfaces drawn with replacement). Then, for the groups beyond the dissertation's range (alpha^p > 3, ours
 28-30): the deviation of their A* from I f with the column means of the groups 18-27, and with b, c, d
 linear in alpha^p fitted over every group. Output: studies/output/table_8_4/table_8_4.md and .png.
+
+Whether the printed fit can be reproduced at all (``printed.png`` and the last section of the report): each
+ensemble's mean A* (node count and corrected) against I f with the printed b, c, d of its group (the text's
+means for groups Table 8.4 does not list), the grid-converged (Richardson) A* of
+studies/grid_convergence.py against the same curve, the printed fit's own slope at p* = 0 against the
+sqrt(pi/2) that section 8.5 says it is close to, and the rescaling p* -> kappa p* of our A* that comes closest to
+the printed curve (a convention factor in p* would show as kappa far from 1 with a small residual).
 """
 
 import argparse
@@ -24,11 +31,17 @@ import os
 
 import numpy as np
 
-from ensemble_common import OUT as ENSEMBLES, load_ensembles, plt
-from roughpetsc.models.curvefit import ALPHA_P_TABLE_8_3, BGT_SLOPE, TABLE_8_4, bootstrap_curvefit, curvefit_area
+from ensemble_common import DISSERTATION_TABLE_8_4_MEANS as PRINTED_MEANS, OUT as ENSEMBLES, load_ensembles, plt
+from grid_convergence import load_rows as grid_convergence_rows, richardson
+from roughpetsc.loads import history
+from roughpetsc.models.complete import complete
+from roughpetsc.models.curvefit import ALPHA_P_TABLE_8_3, BGT_SLOPE, TABLE_8_4, bootstrap_curvefit, curvefit_area, \
+    fit_curvefit
+from scipy.optimize import minimize_scalar
 
 OUT = os.path.join(os.path.dirname(ENSEMBLES), "table_8_4")
 P_MAX = 4.0
+P_FIT = 2.0  # (8.3) corrects I only on p* <= 2
 DISSERTATION_RANGE = range(18, 28)
 KINDS = ("node count", "corrected", "slope")
 
@@ -91,7 +104,11 @@ def main():
         lines.append("")
     lines += summary(rows)
     figure(rows, os.path.join(OUT, "table_8_4.png"))
-    lines += ["", "![b, c, d against alpha^p, and A* - I f](table_8_4.png)"]
+    lines += ["", "![b, c, d against alpha^p, and A* - I f](table_8_4.png)", ""]
+    converged = converged_areas(ensembles)
+    lines += printed_fit_check(ensembles, converged)
+    printed_figure(ensembles, converged, os.path.join(OUT, "printed.png"))
+    lines += ["", "![our A* against the printed fit](printed.png)"]
     with open(os.path.join(OUT, "table_8_4.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
@@ -129,9 +146,134 @@ def summary(rows):
     for e, fits in rows:
         linear_fit = [np.polyval(k, e.alpha_p) for k in linear] if linear is not None else None
         lines.append(f"| {e.group} ({e.N}^2) | {e.alpha_p:.2f} | {fits['node count'][3]:.4f} | "
-                     f"{deviation(e, means['node count']):.4f} | {deviation(e, (-1.913, 1.130, -0.049)):.4f} | "
+                     f"{deviation(e, means['node count']):.4f} | {deviation(e, PRINTED_MEANS):.4f} | "
                      + (f"{deviation(e, linear_fit):.4f}" if linear_fit is not None else "—") + " |")
     return lines + [""]
+
+
+def printed_parameters(group):
+    """Table 8.4's b, c, d of ``group``, or the column means its text gives for the groups it does not list."""
+    return TABLE_8_4.get(group, PRINTED_MEANS)
+
+
+def printed_area(group, pstar, alpha_p):
+    return curvefit_area(pstar, alpha_p, *printed_parameters(group))
+
+
+def printed_slope(group):
+    """dA*/dp* at p* = 0 of the printed fit, I(0) c (d - b), at the group's alpha^p of Table 8.3."""
+    b, c, d = TABLE_8_4[group]
+    return float(complete("greenwood", np.zeros(1), ALPHA_P_TABLE_8_3[group], ALPHA_P_TABLE_8_3[group])[0][0]) \
+        * c * (d - b)
+
+
+def converged_areas(ensembles):
+    """[(group, p*, A*, error bar)]: the Richardson values of studies/grid_convergence.py (node count and corrected
+    A* extrapolate to the same limit; the corrected one, with the smaller error bar, is given)."""
+    rows = grid_convergence_rows()
+    out = []
+    for group, pstar in sorted({(r["group"], r["pstar"]) for r in rows}):
+        selected = [r for r in rows if r["group"] == group and r["pstar"] == pstar]
+        sizes = sorted({r["N"] for r in selected})
+        means = [np.mean([r["A_corrected"] for r in selected if r["N"] == n]) for n in sizes]
+        _, value, error = richardson(sizes, means)
+        out.append((group, pstar, value, error))
+    return out
+
+
+def alpha_p_of(group, ensembles):
+    """Our mean alpha^p of the group (its finest ensemble), else Table 8.3's."""
+    found = [e for e in ensembles if e.group == group]
+    return max(found, key=lambda e: e.N).alpha_p if found else ALPHA_P_TABLE_8_3.get(group)
+
+
+def best_rescaling(e, areas):
+    """(kappa, rms) minimising the rms of A*(kappa p*) - I f(p*) (printed) over the steps with p* <= P_FIT."""
+    sel = e.p <= P_FIT + 1e-12
+    target = printed_area(e.group, e.p[sel], e.alpha_p)
+
+    def rms(kappa):
+        return float(np.sqrt(np.mean((np.interp(kappa * e.p[sel], e.p, areas) - target) ** 2)))
+
+    kappa = minimize_scalar(rms, bounds=(0.5, 1.5), method="bounded").x
+    return kappa, rms(kappa)
+
+
+def printed_fit_check(ensembles, converged):
+    """The report's section on whether any area definition, grid or p* convention reproduces the printed fit."""
+    lines = ["## Can the printed fit be reproduced?", "",
+             "A* - I f with the printed b, c, d of the group (Table 8.4; the text's means -1.913, 1.130, -0.049 "
+             f"for groups it does not list), over the steps with p* <= {P_FIT:g}; kappa: the rescaling p* -> "
+             "kappa p* of our A* closest to the printed curve, with the rms left.", "",
+             "| group | grid | surfaces | area | A* - I f at the smallest p* (ratio) | max A* - I f (at p*) "
+             "| min A* - I f (at p*) | kappa (rms) |", "|---|---|---|---|---|---|---|---|"]
+    for e in ensembles:
+        sel = e.p <= P_FIT + 1e-12
+        curve = printed_area(e.group, e.p[sel], e.alpha_p)
+        for name, areas in (("node count", e.A), ("corrected", e.Ac)):
+            excess = areas[sel] - curve
+            top, bottom = int(np.argmax(excess)), int(np.argmin(excess))
+            kappa, rms = best_rescaling(e, areas)
+            lines.append(f"| {e.group} | {e.N}^2 | {e.n} | {name} | {excess[0]:+.4f} ({areas[sel][0] / curve[0]:.3f}) "
+                         f"| {excess[top]:+.4f} ({e.p[sel][top]:.3f}) | {excess[bottom]:+.4f} "
+                         f"({e.p[sel][bottom]:.3f}) | {kappa:.3f} ({rms:.4f}) |")
+    lines += ["", "The same fit with the weights of the dissertation's load steps: our mean A* interpolated to the "
+              f"steps of the history (7.11) with p* <= {P_FIT:g} (74 of its 95, 30 of them at p* <= 0.2) and "
+              "refitted:", "", "| group | grid | area | b, c, d on (7.11)'s steps | b, c, d on ours |",
+              "|---|---|---|---|---|"]
+    steps = history()
+    steps = steps[steps <= P_FIT + 1e-12]
+    for e in ensembles:
+        sel = e.p <= P_FIT + 1e-12
+        for name, areas in (("node count", e.A), ("corrected", e.Ac)):
+            on_history = fit_curvefit(steps, np.interp(steps, e.p, areas), e.alpha_p)
+            on_ours = fit_curvefit(e.p[sel], areas[sel], e.alpha_p)
+            lines.append(f"| {e.group} | {e.N}^2 | {name} | " + ", ".join(f"{v:.3f}" for v in on_history)
+                         + " | " + ", ".join(f"{v:.3f}" for v in on_ours) + " |")
+    lines += ["", "Grid-converged A* (Richardson over N = 2048-8192, studies/output/grid_convergence/) against the "
+              "printed curve at our alpha^p of the group:", "",
+              "| group | p* | converged A* | error bar | printed I f | difference |", "|---|---|---|---|---|---|"]
+    for group, pstar, value, error in converged:
+        alpha_p = alpha_p_of(group, ensembles)
+        if alpha_p is None:
+            continue
+        curve = float(printed_area(group, [pstar], alpha_p)[0])
+        lines.append(f"| {group} | {pstar:g} | {value:.5f} | {error:.1e} | {curve:.5f} | {value - curve:+.5f} |")
+    lines += ["", f"The printed fit's own slope at p* = 0, I(0) c (d - b) with (5.45) at Table 8.3's alpha^p, "
+              f"against sqrt(pi/2) = {BGT_SLOPE:.4f}, which section 8.5 says it is close to:", "",
+              "| group | " + " | ".join(str(g) for g in sorted(TABLE_8_4)) + " |",
+              "|---|" + "---|" * len(TABLE_8_4),
+              "| slope | " + " | ".join(f"{printed_slope(g):.3f}" for g in sorted(TABLE_8_4)) + " |"]
+    return lines
+
+
+def printed_figure(ensembles, converged, path):
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
+    for e in ensembles:
+        sel = e.p <= P_FIT + 1e-12
+        curve = printed_area(e.group, e.p[sel], e.alpha_p)
+        line, = axes[0].plot(e.p[sel], e.A[sel] - curve, "-", lw=1, label=f"#{e.group} {e.N}^2, node count")
+        axes[0].plot(e.p[sel], e.Ac[sel] - curve, "--", lw=1, color=line.get_color(), label=f"#{e.group}, corrected")
+        axes[1].semilogx(e.p[sel], e.A[sel] / curve, "-", lw=1, color=line.get_color())
+        axes[1].semilogx(e.p[sel], e.Ac[sel] / curve, "--", lw=1, color=line.get_color())
+    for group, pstar, value, error in converged:
+        alpha_p = alpha_p_of(group, ensembles)
+        if alpha_p is None:
+            continue
+        curve = float(printed_area(group, [pstar], alpha_p)[0])
+        axes[0].errorbar([pstar], [value - curve], yerr=[error], fmt="k*", ms=8, capsize=3)
+        axes[1].errorbar([pstar], [value / curve], yerr=[error / curve], fmt="k*", ms=8, capsize=3)
+    axes[0].plot([], [], "k*", label="grid-converged (Richardson)")
+    axes[0].axhline(0.0, color="grey", lw=0.8)
+    axes[1].axhline(1.0, color="grey", lw=0.8)
+    axes[0].set(xlabel="p*", ylabel="A* - I f (printed b, c, d)", title="our A* against the printed fit (8.2)")
+    axes[1].set(xlabel="p*", ylabel="A* / (I f)", title="the same as a ratio")
+    axes[0].legend(fontsize=6, ncol=2)
+    for axis in axes:
+        axis.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 def figure(rows, path):
