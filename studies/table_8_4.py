@@ -81,7 +81,8 @@ def main():
     parser.add_argument("--resamples", type=int, default=400)
     args = parser.parse_args()
     os.makedirs(OUT, exist_ok=True)
-    ensembles = [e for (group, _), e in sorted(load_ensembles().items()) if group in args.groups]
+    every_ensemble = load_ensembles()
+    ensembles = [e for (group, _), e in sorted(every_ensemble.items()) if group in args.groups]
     if not ensembles:
         raise SystemExit(f"no ensemble of groups {args.groups} in {ENSEMBLES}: run studies/ensemble_runs.sh ch8")
     rows = [(e, fits_of(e, args.resamples)) for e in ensembles]
@@ -105,7 +106,7 @@ def main():
     lines += summary(rows)
     figure(rows, os.path.join(OUT, "table_8_4.png"))
     lines += ["", "![b, c, d against alpha^p, and A* - I f](table_8_4.png)", ""]
-    converged = converged_areas(ensembles)
+    converged = converged_areas(list(every_ensemble.values()))
     lines += printed_fit_check(ensembles, converged)
     printed_figure(ensembles, converged, os.path.join(OUT, "printed.png"))
     lines += ["", "![our A* against the printed fit](printed.png)"]
@@ -168,8 +169,9 @@ def printed_slope(group):
 
 
 def converged_areas(ensembles):
-    """[(group, p*, A*, error bar)]: the Richardson values of studies/grid_convergence.py (node count and corrected
-    A* extrapolate to the same limit; the corrected one, with the smaller error bar, is given)."""
+    """[(group, p*, A*, error bar, alpha^p)]: the Richardson values of studies/grid_convergence.py (node count and
+    corrected A* extrapolate to the same limit; the corrected one, with the smaller error bar, is given) and the
+    alpha^p of the group for I (:func:`alpha_p_of` over ``ensembles``); groups with neither are left out."""
     rows = grid_convergence_rows()
     out = []
     for group, pstar in sorted({(r["group"], r["pstar"]) for r in rows}):
@@ -177,7 +179,9 @@ def converged_areas(ensembles):
         sizes = sorted({r["N"] for r in selected})
         means = [np.mean([r["A_corrected"] for r in selected if r["N"] == n]) for n in sizes]
         _, value, error = richardson(sizes, means)
-        out.append((group, pstar, value, error))
+        alpha_p = alpha_p_of(group, ensembles)
+        if alpha_p is not None:
+            out.append((group, pstar, value, error, alpha_p))
     return out
 
 
@@ -233,10 +237,7 @@ def printed_fit_check(ensembles, converged):
     lines += ["", "Grid-converged A* (Richardson over N = 2048-8192, studies/output/grid_convergence/) against the "
               "printed curve at our alpha^p of the group:", "",
               "| group | p* | converged A* | error bar | printed I f | difference |", "|---|---|---|---|---|---|"]
-    for group, pstar, value, error in converged:
-        alpha_p = alpha_p_of(group, ensembles)
-        if alpha_p is None:
-            continue
+    for group, pstar, value, error, alpha_p in converged:
         curve = float(printed_area(group, [pstar], alpha_p)[0])
         lines.append(f"| {group} | {pstar:g} | {value:.5f} | {error:.1e} | {curve:.5f} | {value - curve:+.5f} |")
     lines += ["", f"The printed fit's own slope at p* = 0, I(0) c (d - b) with (5.45) at Table 8.3's alpha^p, "
@@ -256,10 +257,7 @@ def printed_figure(ensembles, converged, path):
         axes[0].plot(e.p[sel], e.Ac[sel] - curve, "--", lw=1, color=line.get_color(), label=f"#{e.group}, corrected")
         axes[1].semilogx(e.p[sel], e.A[sel] / curve, "-", lw=1, color=line.get_color())
         axes[1].semilogx(e.p[sel], e.Ac[sel] / curve, "--", lw=1, color=line.get_color())
-    for group, pstar, value, error in converged:
-        alpha_p = alpha_p_of(group, ensembles)
-        if alpha_p is None:
-            continue
+    for group, pstar, value, error, alpha_p in converged:
         curve = float(printed_area(group, [pstar], alpha_p)[0])
         axes[0].errorbar([pstar], [value - curve], yerr=[error], fmt="k*", ms=8, capsize=3)
         axes[1].errorbar([pstar], [value / curve], yerr=[error / curve], fmt="k*", ms=8, capsize=3)
