@@ -221,12 +221,12 @@ def printed_fit_check(ensembles, converged):
             lines.append(f"| {e.group} | {e.N}^2 | {e.n} | {name} | {excess[0]:+.4f} ({areas[sel][0] / curve[0]:.3f}) "
                          f"| {excess[top]:+.4f} ({e.p[sel][top]:.3f}) | {excess[bottom]:+.4f} "
                          f"({e.p[sel][bottom]:.3f}) | {kappa:.3f} ({rms:.4f}) |")
+    every_step = history()
+    steps = every_step[every_step <= P_FIT + 1e-12]
     lines += ["", "The same fit with the weights of the dissertation's load steps: our mean A* interpolated to the "
-              f"steps of the history (7.11) with p* <= {P_FIT:g} (74 of its 95, 30 of them at p* <= 0.2) and "
-              "refitted:", "", "| group | grid | area | b, c, d on (7.11)'s steps | b, c, d on ours |",
-              "|---|---|---|---|---|"]
-    steps = history()
-    steps = steps[steps <= P_FIT + 1e-12]
+              f"steps of the history (7.11) with p* <= {P_FIT:g} ({steps.size} of its {every_step.size}, "
+              f"{np.count_nonzero(steps <= 0.2 + 1e-12)} of them at p* <= 0.2) and refitted:", "",
+              "| group | grid | area | b, c, d on (7.11)'s steps | b, c, d on ours |", "|---|---|---|---|---|"]
     for e in ensembles:
         sel = e.p <= P_FIT + 1e-12
         for name, areas in (("node count", e.A), ("corrected", e.Ac)):
