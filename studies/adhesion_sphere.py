@@ -22,6 +22,7 @@ the missing ones.
 import argparse
 import math
 import os
+import time
 
 import numpy as np
 
@@ -55,11 +56,16 @@ def run_case(n, lam, steps, radius_0):
     rows = []
     try:
         steps = max(steps, math.ceil((2 * range_ + approach) / (0.5 * range_)))  # steps below half the range
-        for gbar in top + approach_retraction(2 * range_, -approach, steps):
+        path = top + approach_retraction(2 * range_, -approach, steps)
+        started = time.perf_counter()
+        for step, gbar in enumerate(path, 1):
             result = adhesive.solve(gbar)
             rows.append({"gbar": gbar, "P": result.pbar * grid.area, "A": result.A,
                          "A_corrected": result.A_corrected, "natural": result.kkt.natural,
                          "converged": result.converged, "reason": result.reason})
+            print(f"  lambda {lam:g}, N {n}: step {step}/{len(path)}, P / (pi w R) "
+                  f"{rows[-1]['P'] / (math.pi * work * RADIUS):+.4f}, A {result.A:.3e}, natural "
+                  f"{result.kkt.natural:.1e}, {result.reason}, {time.perf_counter() - started:.0f} s", flush=True)
     finally:
         adhesive.destroy()
         problem.destroy()
