@@ -27,8 +27,8 @@
 #                     steps took ~670 s of wall per rank here, along 95 it would take ~30 min
 #   ch7             : groups 1-4 at 1024^2, 50 surfaces each (CH7_SIZE), the 33 steps (groups 3 and 4: the
 #                     steps their figures need, as below); not in the default stages: run it by name
-#   ch8, ch8_2048   : groups 18-30 at 1024^2 and groups 23-27 at 2048^2, 50 surfaces each (CH8_SIZE), the 33
-#                     steps; run by name (groups 28-30 are ours: alpha^p > 3)
+#   ch8, ch8_2048   : groups 18-30 at 1024^2 (CH8_GROUPS: which, in what order) and groups 23-27 at 2048^2, 50
+#                     surfaces each (CH8_SIZE), the 33 steps; run by name (groups 28-30 are ours: alpha^p > 3)
 #   group 4         : not run by default (k_s = 512 is the Nyquist wavenumber of 1024^2, two nodes per
 #                     shortest wavelength; stage g04 runs 2 surfaces at 1024^2)
 # The 33 steps: every third step of (7.11) counted back from p* = 4 (indices 94, 91, ..., 1) plus
@@ -86,7 +86,7 @@ stage() {
         ch8)      # issue 14, items 3-4: chapter 8 at 1024^2, 50 surfaces a group (CH8_SIZE): the dissertation's
                   # groups 18-27 (it ran 23-27 at 2048^2: stage ch8_2048) and our groups 28-30 (alpha^p 3.7,
                   # 3.2, 4.3, beyond its fit's alpha^p < 3)
-                  for g in 18 19 20 21 22 23 24 25 26 27 28 29 30; do
+                  for g in ${CH8_GROUPS:-18 19 20 21 22 23 24 25 26 27 28 29 30}; do
                       run "group${g}_N1024" "$g" 1024 "${CH8_SIZE:-50}" "$SUBSET"
                   done ;;
         ch8_2048) # the groups of k_s = 128 on the dissertation's grid, those the fit needs most first
