@@ -44,25 +44,20 @@ def main():
     parser.add_argument("--rtol", type=float, default=1e-8)
     parser.add_argument("--scan", action="store_true", help="applications against the peak stress (docstring)")
     args = parser.parse_args()
+    if not args.scan and len(args.n) > 1:
+        parser.error("--n takes one size (several only with --scan)")
     common.init()
     if args.scan:
         scan(args)
         return
     args.n = args.n[0]
-    from roughpetsc import Solver
-    from roughpetsc.adhesive import AdhesiveContact
-
     problem = common.group1_problem(args.n)
     rows = []
     for gstar in GSTARS:
         gbar = gstar * problem.sqrt_m0h
-        solver = Solver(problem, "displacement", "pk", args.rtol)
-        reference = solver.solve(gbar=gbar)
-        solver.destroy()
+        reference = reference_solve(problem, gbar, args.rtol)
         for case, law in laws(problem):
-            adhesive = AdhesiveContact(problem, law, rtol=args.rtol)
-            result = adhesive.solve(gbar)
-            adhesive.destroy()
+            result = adhesive_solve(problem, law, gbar, args.rtol)
             rows.append((gstar, case, law.name, reference, result))
             print(f"g* = {gstar}: {case:6s} {law.name:11s} time ratio {result.time_s / reference.time_s:5.2f}, "
                   f"applications {result.operator_applications} / {reference.operator_applications}, "
@@ -71,26 +66,42 @@ def main():
     write(rows, args)
 
 
+def reference_solve(problem, gbar, rtol):
+    """The non-adhesive solve at the mean gap ``gbar``: Polonsky-Keer under displacement control."""
+    from roughpetsc import Solver
+
+    solver = Solver(problem, "displacement", "pk", rtol)
+    try:
+        return solver.solve(gbar=gbar)
+    finally:
+        solver.destroy()
+
+
+def adhesive_solve(problem, law, gbar, rtol):
+    """The adhesive solve of ``law`` at the mean gap ``gbar`` from the rigid start (the gap CG)."""
+    from roughpetsc.adhesive import AdhesiveContact
+
+    adhesive = AdhesiveContact(problem, law, rtol=rtol)
+    try:
+        return adhesive.solve(gbar)
+    finally:
+        adhesive.destroy()
+
+
 def scan(args):
     """Operator applications of the adhesive solve over the reference's, against the peak stress (docstring)."""
-    from roughpetsc import Solver
-    from roughpetsc.adhesive import AdhesiveContact
     from roughpetsc.interaction import Dugdale, Exponential
 
     rows = []
     for n in args.n:
         problem = common.group1_problem(n)
         gbar = SCAN_GSTAR * problem.sqrt_m0h
-        solver = Solver(problem, "displacement", "pk", args.rtol)
-        reference = solver.solve(gbar=gbar)
-        solver.destroy()
+        reference = reference_solve(problem, gbar, args.rtol)
         range_ = SCAN_RANGE * problem.sqrt_m0h
         for peak in SCAN_PEAKS:
             stress = peak * problem.sqrt_m0p
             for law in (Exponential(stress * range_, range_), Dugdale(stress * range_, stress)):
-                adhesive = AdhesiveContact(problem, law, rtol=args.rtol)
-                result = adhesive.solve(gbar)
-                adhesive.destroy()
+                result = adhesive_solve(problem, law, gbar, args.rtol)
                 rows.append((n, peak, law.name, reference, result))
                 print(f"N = {n}, peak {peak}: {law.name:11s} applications {result.operator_applications} / "
                       f"{reference.operator_applications}, {result.reason}", flush=True)
