@@ -178,6 +178,36 @@ def fig_7_complete(ensembles, produced):
         ax.legend(fontsize=7)
 
 
+COMPLETE_STEPS = (2.0, 2.5, 3.1, 4.0)  # p* of Figs. 7.18-7.21 compared in numbers (the nearest stored step)
+
+
+def table_7_complete(ensembles, report):
+    """Figs. 7.18-7.21 in numbers: each nearly-complete model's 1 - A* and g* over the BEM mean at COMPLETE_STEPS."""
+    read = [preferred(ensembles, g) for g in sorted(GROUPS_7)]
+    read = [e for e in read if e is not None]
+    if not read:
+        return
+    report += ["## Figs. 7.18-7.21 in numbers: the nearly-complete models over the BEM", "",
+               "Model / BEM mean of 1 - A* and of g* at the stored step nearest to each p*, the models at the "
+               "ensemble's mean bandwidths (as drawn). BEM spread = std / mean over the surfaces.", "",
+               "| group | grid, surfaces | quantity | p* | BEM spread | "
+               + " | ".join(LABEL.get(name, name) for name in M.COMPLETE_MODELS) + " | Persson |",
+               "|---|---|---|---|---|" + "---|" * (len(M.COMPLETE_MODELS) + 1)]
+    for e in read:
+        steps = sorted({int(np.argmin(np.abs(e.p - p))) for p in COMPLETE_STEPS if e.p.max() >= p - 0.05})
+        for quantity, bem_mean, bem_std, key in (("1 - A*", 1 - e.A, e.A_std, "A"), ("g*", e.g, e.g_std, "gstar")):
+            models = [e.model("complete", name, key) for name in M.COMPLETE_MODELS] + [e.model("persson", None, key)]
+            for i in steps:
+                cells = []
+                for y in models:
+                    value = None if y is None else (1 - y[i] if key == "A" else y[i])
+                    cells.append("—" if value is None or bem_mean[i] == 0 else f"{value / bem_mean[i]:.2f}")
+                spread = bem_std[i] / bem_mean[i] if bem_mean[i] else float("nan")
+                report.append(f"| {e.group} | {e.N}^2, {e.n} | {quantity} | {e.p[i]:.2f} | {spread:.2f} | "
+                              + " | ".join(cells) + " |")
+    report.append("")
+
+
 def table_7_7(ensembles, report):
     read = [e for (g, _), e in sorted(ensembles.items()) if g in GROUPS_7]
     nodes = "; ".join(f"group {e.group} at {e.N}^2: {nodes_per_wavelength(e):g}" for e in read) or "no file read"

@@ -30,7 +30,8 @@ import time
 
 import numpy as np
 
-from ensemble_chapter7 import fig_3_8_to_3_10, fig_7_complete, fig_7_early, fig_7_full, table_7_7
+from ensemble_chapter7 import fig_3_8_to_3_10, fig_7_complete, fig_7_early, fig_7_full, table_7_7, \
+    table_7_complete
 from ensemble_common import (DISSERTATION_TABLE_8_4_MEANS, GROUPS_7, GROUPS_8, OUR_GROUPS_8, OUT, P_RANGE, ROOT,
                              TOLERANCE, M, bem, common_steps, compute_extras, describe, dissertation_curve,
                              dissertation_grid, fractal_group, grid_effect, load_ensembles, nodes_per_wavelength, plt,
@@ -458,6 +459,7 @@ def main():
     fig_7_early(ensembles, produced)
     fig_7_complete(ensembles, produced)
     table_7_7(ensembles, body)
+    table_7_complete(ensembles, body)
     fig_8(ensembles, produced, body)
     rows, fits = acceptance(ensembles, produced, body)
     tail = []
