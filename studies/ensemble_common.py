@@ -111,6 +111,11 @@ class Ens:
         return curves.get(key)
 
 
+def initial_slope(alpha_p, b, c, d, h=1e-5):
+    """dA*/dp* at p* = 0 of the curve fit (8.2)-(8.3)."""
+    return float(np.squeeze(M.curvefit_area(np.array([h]), alpha_p, b, c, d))) / h
+
+
 def load_ensembles():
     out = {}
     for path in sorted(glob.glob(os.path.join(OUT, "group*_N*.h5"))):

@@ -34,8 +34,8 @@ from ensemble_chapter7 import fig_3_8_to_3_10, fig_7_complete, fig_7_early, fig_
     table_7_complete
 from ensemble_common import (DISSERTATION_TABLE_8_4_MEANS, GROUPS_7, GROUPS_8, OUR_GROUPS_8, OUT, P_RANGE, ROOT,
                              TOLERANCE, M, bem, common_steps, compute_extras, describe, dissertation_curve,
-                             dissertation_grid, fractal_group, grid_effect, load_ensembles, nodes_per_wavelength, plt,
-                             preset_grid, save)
+                             dissertation_grid, fractal_group, grid_effect, initial_slope, load_ensembles,
+                             nodes_per_wavelength, plt, preset_grid, save)
 
 
 def grids_of(ens):
@@ -57,11 +57,6 @@ def reference_alpha(e):
 
 def ours(e):
     return e.group not in M.TABLE_8_4
-
-
-def initial_slope(alpha_p, b, c, d, h=1e-5):
-    """dA*/dp* at p* = 0 of the curve fit (8.2)-(8.3)."""
-    return float(np.squeeze(M.curvefit_area(np.array([h]), alpha_p, b, c, d))) / h
 
 
 def chosen_fits(ensembles, fits):
