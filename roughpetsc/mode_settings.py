@@ -127,14 +127,14 @@ def check_ensemble_surfaces(options, option, mode):
 
 
 def fractal_parameters(options):
-    """The fractal surface of the options, checked: ``{"type", "N0", "N", "L", "kl", "ks", "H", "m2"}``.
+    """The fractal surface of the options, checked: ``{"type", "N0", "N", "L", "kl", "ks", "H", "m2", "generator"}``.
 
     Returns ``(grid, parameters)``. Defaults are those of :data:`roughpetsc.surfaces.SURFACE_OPTIONS`
     (:func:`roughpetsc.surfaces.option_values`); ``L`` is the cell length along x.
     """
     given = surfaces.option_values(options, surfaces.TYPE_OPTIONS["fractal"])
     parameters = {"type": "fractal", "kl": given["surface_kl"], "ks": given["surface_ks"], "H": given["surface_H"],
-                  "m2": given["surface_m2"]}
+                  "m2": given["surface_m2"], "generator": given["surface_generator"]}
     with options_named():
         grid = surfaces.grid_from_options(options)
         surfaces.check_fractal_parameters(grid, parameters["kl"], parameters["ks"], parameters["H"], parameters["m2"])

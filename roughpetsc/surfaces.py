@@ -290,6 +290,11 @@ FRACTAL_KEYWORDS = {"surface_kl": "k_l", "surface_ks": "k_s", "surface_H": "hurs
                     "surface_seed": "seed", "surface_generator": "generator"}
 
 
+def option_default(name):
+    """The default of the surface option ``name`` (:data:`SURFACE_OPTIONS`)."""
+    return next(default for option, default, _ in SURFACE_OPTIONS if option == name)
+
+
 def option_values(opts, names):
     """``{name: value}`` of the surface options ``names``, read with the type and default of :data:`SURFACE_OPTIONS`.
 

@@ -19,6 +19,7 @@ import numpy as np  # noqa: E402
 import roughpetsc.models as M  # noqa: E402
 from roughpetsc import ensemble  # noqa: E402
 from roughpetsc.presets import ROOT, fractal_group, fractal_groups  # noqa: E402
+from roughpetsc.store.ensemble_file import stored_config  # noqa: E402
 
 OUT = os.environ.get("ROUGHPETSC_ENSEMBLE_DIR", os.path.join(ROOT, "studies", "output", "ensembles"))
 EXTRAS = os.path.join(OUT, "extras.h5")
@@ -43,7 +44,7 @@ DISSERTATION_FIG_3_9_A = (0.0379, 0.4644, 0.7243, 0.8919)      # the contact rat
 TOLERANCE = 0.02                                       # the project's acceptance target: A* within 0.02 of I f
 P_RANGE = (0.05, 4.0)
 EARLY_PMAX = ensemble.EARLY_PMAX                       # the early-contact stage the store's models cover
-FIELD_GROUP, FIELD_N, FIELD_INDEX = 1, 512, 0
+FIELD_GROUP, FIELD_N, FIELD_INDEX = 1, 1024, 0    # the chapter 7 ensemble of group #1
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -64,7 +65,7 @@ class Ens:
         self.group, self.N = int(m.group(1)), int(m.group(2))
         d = ensemble.read(path)
         self.d = d
-        self.config = json.loads(d["@config"])
+        self.config = stored_config(d["@config"], d.get("@options"))
         self.surface = self.config["surface"]
         self.n = int(d["@n_finished"])
         self.size = int(d["@ensemble_size"])
@@ -168,8 +169,12 @@ def compute_extras():
             grid = Grid(FIELD_N, FIELD_N)
             s = e.surface
             seed = int(e.seeds[row])
-            heights = fractal(grid, s["kl"], s["ks"], s["H"], s["m2"], seed)
+            heights = fractal(grid, s["kl"], s["ks"], s["H"], s["m2"], seed, s["generator"])
             problem = ContactProblem(grid, heights, 1.0, PETSc.COMM_SELF)
+            recorded = float(np.asarray(e.d["surfaces/sqrt_m0h"])[row])
+            if not np.isclose(problem.sqrt_m0h, recorded, rtol=1e-10, atol=0):
+                raise RuntimeError(f"surface {FIELD_INDEX} of {e.path} rebuilt from seed {seed} has sqrt(m0^h) "
+                                   f"{problem.sqrt_m0h:.12g}, the file records {recorded:.12g}: not the same surface")
             solver = Solver(problem, "load", None, 1e-8)
             g = f.create_group("fields")
             g.attrs.update(group=FIELD_GROUP, N=FIELD_N, index=FIELD_INDEX, seed=seed,
@@ -328,26 +333,41 @@ def dissertation_curve(p, group, alpha_p):
     return M.curvefit_area(p, alpha_p, b, c, d)
 
 
-def grid_effect(ensembles):
-    """Group 18 on every grid it ran on (at least two): deviations from the dissertation's curve at the shared steps,
-    and the Richardson extrapolation 2 A_fine - A_coarse from the two finest grids (error ~ h)."""
-    runs = {n: e for (group, n), e in sorted(ensembles.items()) if group == 18}
+def grid_effects(ensembles, p_range=P_RANGE):
+    """{group: effect} for every group run on at least two grids: its mean A* on each grid at the shared steps with
+    p* in ``p_range``, deviations from the dissertation's curve I f, and the Richardson value 2 A_fine - A_coarse from
+    the two finest grids (node-count and corrected A* converge at first order in h: studies/output/grid_convergence),
+    with the standard error of that value from the surfaces of both grids (independent surfaces: the white noise
+    of the generator is drawn per grid)."""
+    return {group: effect for group in sorted({g for g, _ in ensembles})
+            if (effect := grid_effect(ensembles, group, p_range)) is not None}
+
+
+def grid_effect(ensembles, group, p_range=P_RANGE):
+    """The grid effect of one group (:func:`grid_effects`), or None if it ran on fewer than two grids."""
+    runs = {n: e for (g, n), e in sorted(ensembles.items()) if g == group}
     if len(runs) < 2:
         return None
     grids = sorted(runs)
     p, indices = common_steps([runs[n] for n in grids])
-    sel = (p >= P_RANGE[0] - 1e-12) & (p <= P_RANGE[1] + 1e-12)
+    sel = (p >= p_range[0] - 1e-12) & (p <= p_range[1] + 1e-12)
     p = p[sel]
     indices = [i[sel] for i in indices]
-    I_f = dissertation_curve(p, 18, M.ALPHA_P_TABLE_8_3[18])
+    coarse, fine = grids[-2:]
+    alpha_p = float(np.mean([runs[n].alpha_p for n in (coarse, fine)]))
+    I_f = dissertation_curve(p, group, M.ALPHA_P_TABLE_8_3.get(group, alpha_p))
     A = {n: runs[n].A[i] for n, i in zip(grids, indices)}
     Ac = {n: runs[n].Ac[i] for n, i in zip(grids, indices)}
-    coarse, fine = grids[-2:]
     A["inf"], Ac["inf"] = 2 * A[fine] - A[coarse], 2 * Ac[fine] - Ac[coarse]
+    at = dict(zip(grids, indices))
+
+    def error(std):
+        return np.sqrt(4 * std(runs[fine])[at[fine]] ** 2 / runs[fine].n
+                       + std(runs[coarse])[at[coarse]] ** 2 / runs[coarse].n)
+
     labels = [(n, f"{n}^2 mean ({runs[n].n} surfaces)") for n in grids] + \
         [("inf", f"extrapolated h -> 0 (2 A_{fine} - A_{coarse})")]
-    return {"p": p, "A": A, "dev": {k: v - I_f for k, v in A.items()}, "labels": labels,
-            "dev_corrected": {k: v - I_f for k, v in Ac.items()}, "extrapolation": (fine, coarse),
-            "alpha_p": float(np.mean([runs[n].alpha_p for n in grids[-2:]]))}
-
-
+    return {"group": group, "p": p, "A": A, "A_corrected": Ac, "dev": {k: v - I_f for k, v in A.items()},
+            "labels": labels, "dev_corrected": {k: v - I_f for k, v in Ac.items()}, "extrapolation": (fine, coarse),
+            "error": error(lambda e: e.A_std), "error_corrected": error(lambda e: e.Ac_std), "alpha_p": alpha_p,
+            "runs": runs}

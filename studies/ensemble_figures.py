@@ -34,7 +34,7 @@ from ensemble_chapter7 import fig_3_8_to_3_10, fig_7_complete, fig_7_early, fig_
     table_7_complete
 from ensemble_common import (DISSERTATION_TABLE_8_4_MEANS, GROUPS_7, GROUPS_8, OUR_GROUPS_8, OUT, P_RANGE, ROOT,
                              TOLERANCE, M, bem, common_steps, compute_extras, describe, dissertation_curve,
-                             dissertation_grid, fractal_group, grid_effect, initial_slope, load_ensembles,
+                             dissertation_grid, fractal_group, grid_effects, initial_slope, load_ensembles,
                              nodes_per_wavelength, plt, preset_grid, save)
 
 
@@ -224,16 +224,20 @@ def acceptance(ensembles, produced, report):
         label = f"{e.group} (ours)" if ours(e) else f"{e.group}"
         report.append(f"| {label} | {e.N}^2 | {e.n} | {b:.3f} | {sb} | {c:.3f} | {sc} | {d:.4f} | {sd} | "
                       f"{fit_dev:.4f} | {theirs} |")
-    grid = grid_effect(ensembles)
-    if grid is not None:
+    effects = grid_effects(ensembles)
+    for group, grid in effects.items():
         b, c, d = M.fit_curvefit(grid["p"], grid["A"]["inf"], grid["alpha_p"])
         sel = grid["p"] <= P_RANGE[1] + 1e-12
         fit_dev = np.max(np.abs(grid["A"]["inf"][sel] - M.curvefit_area(grid["p"][sel], grid["alpha_p"], b, c, d)))
-        b2, c2, d2 = M.fit_curvefit(grid["p"], grid["A"]["inf"], M.ALPHA_P_TABLE_8_3[18])
-        sb, sc, sd = M.TABLE_8_4[18]
+        printed = M.TABLE_8_4.get(group)
+        sb, sc, sd = (f"{v:.3f}" for v in printed) if printed else ("—",) * 3
+        theirs = "—"
+        if group in M.ALPHA_P_TABLE_8_3:
+            theirs = ", ".join(f"{v:.{3 if j < 2 else 4}f}" for j, v in enumerate(
+                M.fit_curvefit(grid["p"], grid["A"]["inf"], M.ALPHA_P_TABLE_8_3[group])))
         fine, coarse = grid["extrapolation"]
-        report.append(f"| 18 extrapolated (2 A_{fine} - A_{coarse}) | h -> 0 | — | {b:.3f} | {sb:.3f} | {c:.3f} | "
-                      f"{sc:.3f} | {d:.4f} | {sd:.3f} | {fit_dev:.4f} | {b2:.3f}, {c2:.3f}, {d2:.4f} |")
+        report.append(f"| {group} extrapolated (2 A_{fine} - A_{coarse}) | h -> 0 | — | {b:.3f} | {sb} | {c:.3f} | "
+                      f"{sc} | {d:.4f} | {sd} | {fit_dev:.4f} | {theirs} |")
     chosen = chosen_fits(ensembles, fits)
     if len(chosen) > 1:
         arr = np.array([f[1] for f in chosen])
@@ -286,29 +290,39 @@ def acceptance(ensembles, produced, report):
         ax.plot(e.p[sel], e.A[sel] - dissertation_curve(e.p[sel], e.group, reference_alpha(e)), marker="o", ms=2,
                 color=c, ls="--" if ours(e) else "-",
                 label=f"#{e.group}{' ours, vs means' if ours(e) else ''} ({e.N}^2, {e.n})")
-    if grid is not None:
-        ax.plot(grid["p"], grid["dev"]["inf"], "k--", lw=1.2, label="#18 extrapolated to h -> 0 (2 A_%d - A_%d)"
-                % grid["extrapolation"])
+    for group, grid in effects.items():
+        ax.plot(grid["p"], grid["dev"]["inf"], "k--", lw=1.2, label=f"#{group} extrapolated to h -> 0 "
+                "(2 A_%d - A_%d)" % grid["extrapolation"])
     for y in (-TOLERANCE, TOLERANCE):
         ax.axhline(y, color="r", ls="--", lw=0.8)
     ax.set(xlabel="p*", ylabel="A*_mean - I(p*) f(p*)", title="Acceptance: BEM mean minus the dissertation's curve fit")
     ax.legend(fontsize=6.5, ncol=2)
     ax.grid(alpha=0.3)
     save(fig, "acceptance_deviation.png", produced)
-    if grid is not None:
-        report += ["### Grid effect (group 18)", "",
+    for group, grid in effects.items():
+        fine, coarse = grid["extrapolation"]
+        report += [f"### Grid effect (group {group})", "",
                    "Node-count A* carries a discretisation error of the order of the contact perimeter times the "
-                   "node spacing h. Group 18 on each grid read (its preset's, the dissertation's, is "
-                   f"{preset_grid(18)}^2), compared at their shared steps ({grid['p'].size} steps in "
+                   f"node spacing h. Group {group} on each grid read (its preset's, the dissertation's, is "
+                   f"{preset_grid(group)}^2), compared at their shared steps ({grid['p'].size} steps in "
                    f"[{P_RANGE[0]:g}, {P_RANGE[1]:g}]); \"extrapolated\" is the Richardson estimate "
-                   "2 A*_fine - A*_coarse of the h -> 0 limit from the two finest grids (error assumed proportional "
-                   "to h).", "",
-                   "| A* from | max abs(A* - I f) (the dissertation's curve) | at p* | perimeter-corrected "
-                   "|", "|---|---|---|---|"]
+                   "2 A*_fine - A*_coarse of the h -> 0 limit from the two finest grids (error proportional to h, "
+                   "the order studies/grid_convergence.py measures), with the standard error of that estimate from "
+                   "the surfaces of both grids.", "",
+                   "| A* from | max abs(A* - I f) (the dissertation's curve) | at p* | perimeter-corrected |",
+                   "|---|---|---|---|"]
         for key, label in grid["labels"]:
             dev, devc = grid["dev"][key], grid["dev_corrected"][key]
             k = int(np.argmax(np.abs(dev)))
             report.append(f"| {label} | {abs(dev[k]):.4f} | {grid['p'][k]:.3f} | {np.max(np.abs(devc)):.4f} |")
+        report += ["", f"A* at a few steps (node count; corrected in brackets); last column: the extrapolated "
+                   "value's standard error:", "",
+                   "| p* | " + " | ".join(label for _, label in grid["labels"]) + " | std. error |",
+                   "|---|" + "---|" * (len(grid["labels"]) + 1)]
+        for k in np.unique([int(np.argmin(np.abs(grid["p"] - x))) for x in (0.05, 0.5, 1.0, 2.0, 4.0)]):
+            report.append(f"| {grid['p'][k]:.3f} | " + " | ".join(
+                f"{grid['A'][key][k]:.4f} ({grid['A_corrected'][key][k]:.4f})" for key, _ in grid["labels"])
+                + f" | {grid['error'][k]:.1e} ({grid['error_corrected'][k]:.1e}) |")
         report.append("")
     return rows, fits
 
@@ -376,7 +390,7 @@ def differences(ensembles, report):
     off = [e for e in all_e if preset_grid(e.group) not in (None, e.N)]
     missing = [g for g in sorted(set(theirs) | set(OUR_GROUPS_8)) if not any(e.group == g for e in all_e)]
     unfinished = [e for e in all_e if not e.complete]
-    grid = grid_effect(ensembles)
+    effects = grid_effects(ensembles)
 
     full = history()
     kinds = {}
@@ -405,8 +419,9 @@ def differences(ensembles, report):
                + (f" No file for group(s) {spans(missing)}." if missing else "")
                + " Node-count A* counts every boundary node with p > 0 as a whole node, so it depends on the grid; the "
                "perimeter-corrected A* is shown beside it"
-               + (f" and the grid effect of group 18 ({grids_of([e for e in all_e if e.group == 18])}) is measured "
-                  "above." if grid is not None else "."),
+               + (" and the grid effect is measured above for "
+                  + ", ".join(f"group {g} ({grids_of([e for e in all_e if e.group == g])})" for g in effects) + "."
+                  if effects else "."),
                "- **Surfaces per group.** The dissertation: 50 per group. Ours: "
                + (f"{min(e.n for e in all_e)} to {max(e.n for e in all_e)} per file (table above)"
                   if len({e.n for e in all_e}) > 1 else f"{all_e[0].n} per file")
@@ -492,10 +507,9 @@ def main():
                        f"{slope_theirs:.2f} (means; sqrt(pi/2) = {np.sqrt(np.pi / 2):.3f}); our fits agree with our "
                        f"means to <= {max(f[2] for f in chosen):.4f} (p* in [{P_RANGE[0]:g}, {P_RANGE[1]:g}]). "
                        "Bootstrap intervals: `studies/table_8_4.py`.")
-    grid = grid_effect(ensembles)
-    if grid is not None:
+    for group, grid in grid_effects(ensembles).items():
         dev = grid["dev"]
-        summary.append("- Group 18 grid effect: max deviation "
+        summary.append(f"- Group {group} grid effect: max deviation from the dissertation's curve "
                        + ", ".join(f"{label} {np.max(np.abs(dev[key])):.4f}" for key, label in grid["labels"])
                        + " (see 'Grid effect' below)")
     if not rows:

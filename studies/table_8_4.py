@@ -31,8 +31,8 @@ import os
 
 import numpy as np
 
-from ensemble_common import DISSERTATION_TABLE_8_4_MEANS as PRINTED_MEANS, OUT as ENSEMBLES, initial_slope, \
-    load_ensembles, plt
+from ensemble_common import DISSERTATION_TABLE_8_4_MEANS as PRINTED_MEANS, OUT as ENSEMBLES, dissertation_grid, \
+    grid_effects, initial_slope, load_ensembles, plt
 from grid_convergence import load_rows as grid_convergence_rows, richardson
 from roughpetsc.loads import history
 from roughpetsc.models.curvefit import ALPHA_P_TABLE_8_3, BGT_SLOPE, TABLE_8_4, bootstrap_curvefit, curvefit_area, \
@@ -103,7 +103,8 @@ def main():
                          + " | ".join(interval(fit[j], lower[j], upper[j], 3 if j < 2 else 4) for j in range(3))
                          + f" | {dev:.4f} | {printed} |")
         lines.append("")
-    lines += summary(rows)
+    lines += summary([(e, fits) for e, fits in rows if e is dissertation_grid(every_ensemble, e.group)])
+    lines += grid_section(every_ensemble, args.groups, args.resamples)
     figure(rows, os.path.join(OUT, "table_8_4.png"))
     lines += ["", "![b, c, d against alpha^p, and A* - I f](table_8_4.png)", ""]
     converged = converged_areas(list(every_ensemble.values()))
@@ -116,9 +117,12 @@ def main():
 
 
 def summary(rows):
-    """Column means over the dissertation's groups, and how they (or b, c, d linear in alpha^p) serve the rest."""
+    """Column means over the dissertation's groups, and how they (or b, c, d linear in alpha^p) serve the rest; one
+    ensemble per group in ``rows`` (that on the dissertation's grid, :func:`ensemble_common.dissertation_grid`)."""
     inside = [(e, fits) for e, fits in rows if e.group in DISSERTATION_RANGE]
-    lines = ["## Column means and the groups beyond alpha^p = 3", ""]
+    lines = ["## Column means and the groups beyond alpha^p = 3", "",
+             "One ensemble per group: " + ", ".join(f"#{e.group} {e.N}^2 ({e.n})" for e, _ in rows)
+             + " (the dissertation's grid where that file is present).", ""]
     if len(inside) < 2:
         return lines + ["Fewer than two of the dissertation's groups 18-27 are in: no column means yet.", ""]
     lines += ["| | b | c | d |", "|---|---|---|---|"]
@@ -150,6 +154,63 @@ def summary(rows):
                      f"{deviation(e, means['node count']):.4f} | {deviation(e, PRINTED_MEANS):.4f} | "
                      + (f"{deviation(e, linear_fit):.4f}" if linear_fit is not None else "—") + " |")
     return lines + [""]
+
+
+def extrapolated_fits(effect, resamples, seed=0):
+    """b, c, d of the Richardson-extrapolated mean A* 2 A_fine - A_coarse of a group run on two grids, node count and
+    corrected, each with a 95 % bootstrap interval (the surfaces of each grid drawn with replacement, independently:
+    the two grids' surfaces are different realisations)."""
+    fine, coarse = effect["extrapolation"]
+    runs = effect["runs"]
+    steps = {n: np.array([int(np.argmin(np.abs(runs[n].p - x))) for x in effect["p"]]) for n in (fine, coarse)}
+    rng = np.random.default_rng(seed)
+    out = {}
+    for name, index in (("node count", 0), ("corrected", 1)):
+        areas = {n: per_surface_areas(runs[n])[index][:, steps[n]] for n in (fine, coarse)}
+
+        def extrapolated(draw=False):
+            mean = {n: (areas[n][rng.integers(0, len(areas[n]), len(areas[n]))] if draw else areas[n]).mean(axis=0)
+                    for n in (fine, coarse)}
+            return 2 * mean[fine] - mean[coarse]
+
+        fit = fit_curvefit(effect["p"], extrapolated(), effect["alpha_p"])
+        draws = np.array([fit_curvefit(effect["p"], extrapolated(True), effect["alpha_p"], guess=(fit[0], fit[2]))
+                          for _ in range(resamples)])
+        lower, upper = np.percentile(draws, [2.5, 97.5], axis=0)
+        sel = effect["p"] <= P_MAX + 1e-12
+        curve = printed_area(effect["group"], effect["p"][sel], effect["alpha_p"])
+        out[name] = (np.array(fit), lower, upper, extrapolated()[sel] - curve)
+    return out
+
+
+def grid_section(ensembles, groups, resamples):
+    """The report's section on the groups run on two grids: b, c, d on each and from the extrapolated A*."""
+    effects = {g: effect for g, effect in grid_effects(ensembles, (0.0, P_MAX)).items() if g in groups}
+    lines = ["## Two grids: b, c, d on each and extrapolated to h -> 0", ""]
+    if not effects:
+        return lines + ["No group of these has run on two grids.", ""]
+    lines += ["Groups with ensembles on two grids (different surfaces of the same group on each). b, c, d of the "
+              "mean A* on each grid (node count), and of the Richardson value 2 A*_fine - A*_coarse (first order in "
+              "h, studies/output/grid_convergence), node count and corrected, with 95 % bootstrap intervals; last "
+              "columns: the extrapolated A* minus the printed I f at the smallest p* and its extreme over "
+              f"p* <= {P_MAX:g}.", "",
+              "| group | A* from | surfaces | b | c | d | A* - I f (printed) at smallest p* | extreme |",
+              "|---|---|---|---|---|---|---|---|"]
+    for group, effect in effects.items():
+        for n, e in sorted(effect["runs"].items()):
+            fit = fits_of(e, resamples)["node count"]
+            lines.append(f"| {group} | {n}^2, node count | {e.n} | "
+                         + " | ".join(interval(fit[0][j], fit[1][j], fit[2][j], 3 if j < 2 else 4) for j in range(3))
+                         + " | — | — |")
+        fine, coarse = effect["extrapolation"]
+        for name, (fit, lower, upper, excess) in extrapolated_fits(effect, resamples).items():
+            extreme = int(np.argmax(np.abs(excess)))
+            lines.append(f"| {group} | 2 A_{fine} - A_{coarse}, {name} | — | "
+                         + " | ".join(interval(fit[j], lower[j], upper[j], 3 if j < 2 else 4) for j in range(3))
+                         + f" | {excess[0]:+.4f} (p* {effect['p'][0]:.3f}) | {excess[extreme]:+.4f} "
+                         f"(p* {effect['p'][extreme]:.3f}) |")
+    printed = ", ".join(f"#{g}: " + ", ".join(f"{v:.3f}" for v in printed_parameters(g)) for g in effects)
+    return lines + ["", f"Printed b, c, d: {printed}.", ""]
 
 
 def printed_parameters(group):

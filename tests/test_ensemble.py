@@ -258,6 +258,27 @@ def test_foreign_or_different_file_is_not_overwritten(tmp_path):
     assert open(path, "rb").read() == before
 
 
+def test_a_file_resumes_only_with_its_surface_generator(tmp_path):
+    """Surfaces of two generators never share a file; a file whose configuration predates the generator's place in
+    it is read with the generator its recorded options name."""
+    path = tmp_path / "e.h5"
+    first = SMALL + ["-ensemble_loads", "0.1", "-output", path, "-surface_generator", "xu"]
+    assert run_cli(first + ["-ensemble_size", 1]).returncode == 0
+    before = open(path, "rb").read()
+    out = run_cli(SMALL + ["-ensemble_loads", "0.1", "-output", path, "-surface_generator", "filter",
+                           "-ensemble_size", 2])
+    assert out.returncode == 2 and "-output" in out.stderr and "differs in surface" in out.stderr
+    assert open(path, "rb").read() == before
+    with h5py.File(path, "r+") as f:     # the configuration as files written before the generator was in it
+        config = json.loads(f.attrs["config"])
+        assert config["surface"].pop("generator") == "xu"
+        f.attrs["config"] = json.dumps(config, sort_keys=True)
+    out = run_cli(first + ["-ensemble_size", 2])
+    assert out.returncode == 0, out.stderr
+    assert ensemble.read(path)["@n_finished"] == 2
+    assert json.loads(ensemble.read(path)["@config"])["surface"]["generator"] == "xu"
+
+
 def test_non_converged_steps_are_recorded_and_exit_3(tmp_path):
     out = run_cli(SMALL + ["-ensemble_size", 2, "-ensemble_loads", "0.05,0.1", "-tao_max_it", 2,
                            "-output", tmp_path / "n.h5"])

@@ -138,6 +138,19 @@ def _records_from(surfaces, steps, reasons):
     return records
 
 
+def stored_config(config, options):
+    """The configuration JSON of a file, as a dict; a file written before the fractal surface's generator was part
+    of it gets the generator its options JSON records (``-surface_generator``, else the option's default)."""
+    from ..surfaces import option_default
+
+    config = json.loads(config)
+    surface = config.get("surface", {})
+    if surface.get("type") == "fractal" and "generator" not in surface:
+        given = json.loads(options) if options else {}
+        surface["generator"] = given.get("surface_generator", option_default("surface_generator"))
+    return config
+
+
 def read_records(path, config):
     """Finished surfaces of an existing ensemble file (checked against ``config``), its run log and FFTW wisdom.
 
@@ -156,7 +169,7 @@ def read_records(path, config):
             if found != FORMAT:
                 raise UserError(f"-output {path}: the file exists and is not a roughpetsc ensemble file; "
                                 f"refusing to overwrite it")
-            old = json.loads(f.attrs["config"])
+            old = stored_config(f.attrs["config"], f.attrs.get("options"))
             runs = json.loads(f.attrs["runs"])
             wisdom = str(f.attrs.get("fftw_wisdom", ""))
             surfaces = {field: f["surfaces"][field][()] for field in SURFACE_FIELDS}
