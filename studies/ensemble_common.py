@@ -105,6 +105,12 @@ class Ens:
     def wall_seconds(self):
         return sum(r.get("seconds", 0.0) for r in self.runs)
 
+    def rank_hours(self):
+        """Rank-hours of the finished surfaces: each one's recorded time times the ranks that solved it."""
+        ranks = {int(r["run"]): int(r.get("group_ranks", 1)) for r in self.runs}
+        run = np.asarray(self.d["surfaces/run"], int)
+        return float(sum(t * ranks.get(int(k), 1) for t, k in zip(self.surface_time, run))) / 3600.0
+
     def model(self, family, name, key):
         """A stored model curve at the steps (``family`` early | complete | persson), or None if not stored."""
         curves = self.models.get(family, {})

@@ -341,8 +341,8 @@ def spans(numbers):
 def notes(ensembles, report):
     report += ["## Ensembles, grids, convergence", "",
                "| file | group (k_l, k_s, H) | grid | nodes per 1/k_s | surfaces | load steps | steps converged | "
-               "max KKT natural | max load error | wall time (s) | mean s / surface |",
-               "|---|---|---|---|---|---|---|---|---|---|---|"]
+               "max KKT natural | max load error | wall time (s) | mean s / surface | rank-hours |",
+               "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for (group, n), e in sorted(ensembles.items()):
         s = e.surface
         interrupted = [r for r in e.runs if "seconds" not in r]
@@ -352,7 +352,7 @@ def notes(ensembles, report):
                       f"{np.nanmax(e.kkt):.2e} | {np.nanmax(e.load_error):.1e} | {e.wall_seconds():.0f}"
                       + (f" (+ {len(interrupted)} unfinished or interrupted run(s), solved "
                          f"{sum(len(r.get('solved', ())) for r in interrupted)} surf.)" if interrupted else "")
-                      + f" | {e.surface_time.mean():.1f} |")
+                      + f" | {e.surface_time.mean():.1f} | {e.rank_hours():.2f} |")
     all_e = list(ensembles.values())
     solvers = ", ".join(sorted({e.solver for e in all_e}))
     rtols = ", ".join(f"{r:g}" for r in sorted({e.rtol for e in all_e}))
@@ -366,7 +366,9 @@ def notes(ensembles, report):
                + (f" ({'/'.join(map(str, ranks))} MPI ranks, {'/'.join(map(str, per_surface))} rank(s) per surface)"
                   if ranks and per_surface else "")
                + ", wall clock, so it includes whatever else ran on the machine at the time; mean s / surface = the "
-               "recorded time of one surface's whole load path on its rank(s).", ""]
+               "recorded time of one surface's whole load path on its rank(s); rank-hours = the sum over the "
+               f"surfaces of that time times the ranks that solved it ({sum(e.rank_hours() for e in all_e):.1f} over "
+               "the files read).", ""]
 
 
 def differences(ensembles, report):

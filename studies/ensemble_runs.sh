@@ -28,7 +28,9 @@
 #   ch7             : groups 1-4 at 1024^2, 50 surfaces each (CH7_SIZE), the 33 steps (groups 3 and 4: the
 #                     steps their figures need, as below); not in the default stages: run it by name
 #   ch8, ch8_2048   : groups 18-30 at 1024^2 (CH8_GROUPS: which, in what order) and groups 23-27 at 2048^2, 50
-#                     surfaces each (CH8_SIZE), the 33 steps; run by name (groups 28-30 are ours: alpha^p > 3)
+#                     surfaces each (CH8_SIZE), the 33 steps; run by name (groups 28-30 are ours: alpha^p > 3).
+#                     Measured: a 1024^2 surface 53-156 s on one core, a 2048^2 one 310-430 s; ch8_2048 with
+#                     CH8_SIZE=10 took 2.7 h of wall on 2 ranks (10 surfaces for each of groups 23-27)
 #   group 4         : not run by default (k_s = 512 is the Nyquist wavenumber of 1024^2, two nodes per
 #                     shortest wavelength; stage g04 runs 2 surfaces at 1024^2)
 # The 33 steps: every third step of (7.11) counted back from p* = 4 (indices 94, 91, ..., 1) plus
