@@ -300,9 +300,8 @@ def option_values(opts, names):
 
     ``opts`` is a ``petsc4py.PETSc.Options`` (or anything with its ``get*`` methods).
     """
-    defaults = {name: default for name, default, _ in SURFACE_OPTIONS}
     read = {int: opts.getInt, float: opts.getReal, str: opts.getString}
-    return {name: read[type(defaults[name])](name, defaults[name]) for name in names}
+    return {name: read[type(default)](name, default) for name in names for default in (option_default(name),)}
 
 
 def parameters(opts):

@@ -376,4 +376,4 @@ def grid_effect(ensembles, group, p_range=P_RANGE):
     return {"group": group, "p": p, "A": A, "A_corrected": Ac, "dev": {k: v - I_f for k, v in A.items()},
             "labels": labels, "dev_corrected": {k: v - I_f for k, v in Ac.items()}, "extrapolation": (fine, coarse),
             "error": error(lambda e: e.A_std), "error_corrected": error(lambda e: e.Ac_std), "alpha_p": alpha_p,
-            "runs": runs}
+            "runs": runs, "steps": at}

@@ -104,7 +104,7 @@ def main():
                          + f" | {dev:.4f} | {printed} |")
         lines.append("")
     lines += summary([(e, fits) for e, fits in rows if e is dissertation_grid(every_ensemble, e.group)])
-    lines += grid_section(every_ensemble, args.groups, args.resamples)
+    lines += grid_section(every_ensemble, args.groups, args.resamples, {id(e): fits for e, fits in rows})
     figure(rows, os.path.join(OUT, "table_8_4.png"))
     lines += ["", "![b, c, d against alpha^p, and A* - I f](table_8_4.png)", ""]
     converged = converged_areas(list(every_ensemble.values()))
@@ -162,7 +162,7 @@ def extrapolated_fits(effect, resamples, seed=0):
     the two grids' surfaces are different realisations)."""
     fine, coarse = effect["extrapolation"]
     runs = effect["runs"]
-    steps = {n: np.array([int(np.argmin(np.abs(runs[n].p - x))) for x in effect["p"]]) for n in (fine, coarse)}
+    steps = effect["steps"]
     rng = np.random.default_rng(seed)
     out = {}
     for name, index in (("node count", 0), ("corrected", 1)):
@@ -183,8 +183,9 @@ def extrapolated_fits(effect, resamples, seed=0):
     return out
 
 
-def grid_section(ensembles, groups, resamples):
-    """The report's section on the groups run on two grids: b, c, d on each and from the extrapolated A*."""
+def grid_section(ensembles, groups, resamples, fits):
+    """The report's section on the groups run on two grids: b, c, d on each (``fits``: :func:`fits_of` by ``id`` of
+    the ensemble) and from the extrapolated A*."""
     effects = {g: effect for g, effect in grid_effects(ensembles, (0.0, P_MAX)).items() if g in groups}
     lines = ["## Two grids: b, c, d on each and extrapolated to h -> 0", ""]
     if not effects:
@@ -198,7 +199,7 @@ def grid_section(ensembles, groups, resamples):
               "|---|---|---|---|---|---|---|---|"]
     for group, effect in effects.items():
         for n, e in sorted(effect["runs"].items()):
-            fit = fits_of(e, resamples)["node count"]
+            fit = fits[id(e)]["node count"]
             lines.append(f"| {group} | {n}^2, node count | {e.n} | "
                          + " | ".join(interval(fit[0][j], fit[1][j], fit[2][j], 3 if j < 2 else 4) for j in range(3))
                          + " | — | — |")
