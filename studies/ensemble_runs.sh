@@ -2,7 +2,8 @@
 # The BEM ensembles behind studies/ensemble_figures.py (issue 6, item 5): the dissertation, ch. 7.3-7.4 (groups 1-3)
 # and ch. 8 (groups 18-27). One `mpiexec -n 2` ensemble at a time (one surface per rank), each resumable:
 # rerun this script (or one stage of it) after a kill and the finished surfaces are kept; a larger
-# -ensemble_size extends a file, a smaller one (>= the surfaces it holds) finalises it.
+# -ensemble_size extends a file, a smaller one (>= the surfaces it holds) finalises it. The files (~0.1 MB each)
+# are tracked by git: commit them after a session and a fresh clone on a new machine resumes where it stopped.
 #
 #   bash studies/ensemble_runs.sh            # all stages, in order of priority
 #   bash studies/ensemble_runs.sh g18 g01    # only the named stages
