@@ -14,19 +14,16 @@ promise.
 import argparse
 import os
 import sys
+from collections import namedtuple
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
-from ensemble_common import OUT, Ens  # noqa: E402
+from ensemble_common import load_ensembles  # noqa: E402
 
 STAGES = (("ch7", (1, 2, 3, 4), 1024), ("ch8", tuple(range(18, 31)), 1024), ("ch8_2048", (27, 23, 25, 24, 26), 2048))
 
-
-def read(group, n):
-    """The ensemble file of a group on the n x n grid, or None if there is none yet."""
-    path = os.path.join(OUT, f"group{group:02d}_N{n}.h5")
-    return Ens(path) if os.path.exists(path) else None
+Row = namedtuple("Row", "stage group n done converged steps spent to_go estimated")
 
 
 def mean_surface_hours(ensembles):
@@ -36,10 +33,9 @@ def mean_surface_hours(ensembles):
 
 
 def status(target):
-    """Rows (stage, group, N, finished, converged steps, steps, rank-hours spent, to go, estimated?)."""
-    found = {(group, n): read(group, n) for _, groups, n in STAGES for group in groups}
-    per_grid = {n: mean_surface_hours([e for (_, m), e in found.items() if m == n and e is not None and e.n])
-                for _, _, n in STAGES}
+    """One :class:`Row` per ensemble of :data:`STAGES`, in their order."""
+    found = load_ensembles()    # only files holding finished surfaces, keyed by (group, N)
+    per_grid = {n: mean_surface_hours([e for (_, m), e in found.items() if m == n]) for _, _, n in STAGES}
     measured = {n: hours for n, hours in per_grid.items() if not np.isnan(hours)}
     for n, hours in per_grid.items():
         if np.isnan(hours) and measured:
@@ -50,13 +46,13 @@ def status(target):
     rows = []
     for stage, groups, n in STAGES:
         for group in groups:
-            e = found[(group, n)]
-            done = e.n if e is not None else 0
-            own = e is not None and e.n > 0
-            each = e.rank_hours() / e.n if own else per_grid[n]
-            steps = int(e.converged.sum()) if own else 0
-            rows.append((stage, group, n, done, steps, done * (e.p.size if own else 0),
-                         e.rank_hours() if own else 0.0, max(target - done, 0) * each, not own))
+            e = found.get((group, n))
+            if e is None:
+                rows.append(Row(stage, group, n, 0, 0, 0, 0.0, target * per_grid[n], True))
+                continue
+            spent = e.rank_hours()
+            rows.append(Row(stage, group, n, e.n, int(e.converged.sum()), e.n * e.p.size, spent,
+                            max(target - e.n, 0) * spent / e.n, False))
     return rows
 
 
@@ -66,13 +62,13 @@ def main():
     args = parser.parse_args()
     rows = status(args.target)
     print(f"{'stage':9s} {'group':>5s} {'grid':>6s} {'surfaces':>9s} {'converged':>11s} {'rank-h':>7s} {'to go':>7s}")
-    for stage, group, n, done, converged, steps, spent, to_go, estimated in rows:
-        go = "?" if np.isnan(to_go) else f"{'~' if estimated and to_go else ''}{to_go:.2f}"
-        print(f"{stage:9s} {group:5d} {n:5d}^2 {done:4d}/{args.target:<4d} {converged:5d}/{steps:<5d} "
-              f"{spent:7.2f} {go:>7s}")
-    spent = sum(r[6] for r in rows)
-    to_go = sum(r[7] for r in rows)
-    done = sum(r[3] for r in rows)
+    for r in rows:
+        go = "?" if np.isnan(r.to_go) else f"{'~' if r.estimated and r.to_go else ''}{r.to_go:.2f}"
+        print(f"{r.stage:9s} {r.group:5d} {r.n:5d}^2 {r.done:4d}/{args.target:<4d} {r.converged:5d}/{r.steps:<5d} "
+              f"{r.spent:7.2f} {go:>7s}")
+    spent = sum(r.spent for r in rows)
+    to_go = sum(r.to_go for r in rows)
+    done = sum(r.done for r in rows)
     print(f"total: {done}/{len(rows) * args.target} surfaces, {spent:.2f} rank-hours spent, "
           f"{'?' if np.isnan(to_go) else f'{to_go:.1f}'} rank-hours to go "
           f"({'?' if np.isnan(to_go) else f'{to_go / 2:.1f}'} h of wall on 2 ranks)")
