@@ -491,8 +491,7 @@ def main():
                        f"{e.n} surfaces{'' if e.complete else f' of {e.size}'}): max |A*_mean - I f| = {s[0]:.4f} at "
                        f"p* = {s[1]:.3f} -> {'PASS' if s[0] <= TOLERANCE else 'FAIL'} (tolerance {TOLERANCE})")
     for label, subset in (("the dissertation's groups", [r for r in rows if not ours(r[0])]),
-                               ("our groups beyond alpha^p = 3, against the column means",
-                                [r for r in rows if ours(r[0])])):
+                          ("our groups beyond alpha^p = 3, against the column means", [r for r in rows if ours(r[0])])):
         corrected = [dev["corrected"][0] for _, dev, _ in subset]
         if corrected:
             summary.append(f"- Perimeter-corrected A* (Yastrebov et al.) against the same curve, {label}: max "
