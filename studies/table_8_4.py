@@ -23,7 +23,8 @@ ensemble's mean A* (node count and corrected) against I f with the printed b, c,
 means for groups Table 8.4 does not list), the grid-converged (Richardson) A* of
 studies/grid_convergence.py against the same curve, the printed fit's own slope at p* = 0 against the
 sqrt(pi/2) that section 8.5 says it is close to, and the rescaling p* -> kappa p* of our A* that comes closest to
-the printed curve (a convention factor in p* would show as kappa far from 1 with a small residual).
+the printed curve (a convention factor in p* would show as kappa far from 1 with a small residual), and which
+area definition and grid (node count, corrected, Richardson-extrapolated) the printed curve is closest to.
 """
 
 import argparse
@@ -109,6 +110,7 @@ def main():
     lines += ["", "![b, c, d against alpha^p, and A* - I f](table_8_4.png)", ""]
     converged = converged_areas(list(every_ensemble.values()))
     lines += printed_fit_check(ensembles, converged)
+    lines += closest_area(every_ensemble)
     printed_figure(ensembles, converged, os.path.join(OUT, "printed.png"))
     lines += ["", "![our A* against the printed fit](printed.png)"]
     with open(os.path.join(OUT, "table_8_4.md"), "w") as f:
@@ -301,6 +303,44 @@ def printed_fit_check(ensembles, converged):
               "|---|" + "---|" * len(TABLE_8_4),
               "| slope | " + " | ".join(f"{initial_slope(ALPHA_P_TABLE_8_3[g], *TABLE_8_4[g]):.3f}"
                                         for g in sorted(TABLE_8_4)) + " |"]
+    return lines
+
+
+def closest_area(ensembles):
+    """Which area definition and grid the printed curve is closest to (issue 14, item 2): over the groups of Table 8.4
+    and the steps with p* <= P_FIT, the largest |A* - I f| of each group (I at our alpha^p, as in the table above) and
+    its rms over the steps, for node-count and perimeter-corrected A* on each grid and for the Richardson value
+    2 A_fine - A_coarse of the groups run on two grids."""
+    candidates = {}
+    for (group, n), e in sorted(ensembles.items()):
+        if group in TABLE_8_4:
+            sel = e.p <= P_FIT + 1e-12
+            curve = printed_area(group, e.p[sel], e.alpha_p)
+            for name, areas in (("node count", e.A), ("corrected", e.Ac)):
+                candidates.setdefault((name, f"{n}^2"), []).append(areas[sel] - curve)
+    for group, effect in grid_effects(ensembles, (0.0, P_FIT)).items():
+        if group in TABLE_8_4:
+            fine, coarse = effect["extrapolation"]
+            curve = printed_area(group, effect["p"], effect["alpha_p"])
+            for name, key in (("node count", "A"), ("corrected", "A_corrected")):
+                candidates.setdefault((name, f"2 A_{fine} - A_{coarse}"), []).append(effect[key]["inf"] - curve)
+    if not candidates:
+        return []
+    lines = ["", "### Which area definition and grid the printed curve is closest to", "",
+             f"Over the groups of Table 8.4 present on each grid, steps with p* <= {P_FIT:g}: the range over the groups "
+             "of max |A* - I f| (printed b, c, d) and of the rms of A* - I f over the steps.", "",
+             "| area | grid | groups | max abs(A* - I f) | rms |", "|---|---|---|---|---|"]
+    worst = {}
+    for (name, grid), excesses in candidates.items():
+        peaks = [float(np.abs(x).max()) for x in excesses]
+        rms = [float(np.sqrt(np.mean(x ** 2))) for x in excesses]
+        worst[(name, grid)] = max(peaks)
+        lines.append(f"| {name} | {grid} | {len(excesses)} | {min(peaks):.4f} - {max(peaks):.4f} "
+                     f"| {min(rms):.4f} - {max(rms):.4f} |")
+    ranked = sorted(worst, key=worst.get)
+    lines += ["", "Closest, by the worst group: " + "; then ".join(f"{name} on {grid} ({worst[(name, grid)]:.4f})"
+                                                          for name, grid in ranked[:3])
+              + f". Farthest: {ranked[-1][0]} on {ranked[-1][1]} ({worst[ranked[-1]]:.4f})."]
     return lines
 
 
