@@ -78,15 +78,19 @@ class RootFind(Backend):
             side = "above" if mean_p > pbar else "below"  # the closest solutions on each side of the load
             pressure.copy(self.bracket[side])
             state[side] = (d, mean_p)
+            inner_solved = outcome.reason.startswith("CONVERGED")
+            if abs(mean_p - pbar) <= self.rtol * pbar and inner_solved:
+                raise Found
+            # The time limit before the load: an inner solve cut short at its start keeps the start's mean
+            # pressure, which may be the load itself.
+            if history.out_of_time(self.qp.max_seconds):
+                state["stop"] = "DIVERGED_USER"
+                raise Found
             if abs(mean_p - pbar) <= self.rtol * pbar:
-                if not outcome.reason.startswith("CONVERGED"):
-                    state["stop"] = "DIVERGED_ROOT_INNER"  # the load is met, the inner QP is not solved
+                state["stop"] = "DIVERGED_ROOT_INNER"  # the load is met, the inner QP is not solved
                 raise Found
             if state["evaluations"] >= self.max_evaluations:
                 state["stop"] = "DIVERGED_ROOT_MAXFCN"
-                raise Found
-            if history.out_of_time(self.qp.max_seconds):
-                state["stop"] = "DIVERGED_USER"
                 raise Found
             return mean_p - pbar
 
