@@ -146,6 +146,15 @@ def test_default_curve_fit_is_5_37_with_2_42_by_quadrature(group):
     assert M.curvefit_area(p, ap, b, c, d) == pytest.approx(reference, rel=1e-7, abs=1e-9)
 
 
+@pytest.mark.parametrize("model", ["gw", "greenwood"])
+def test_slope_at_zero_is_the_curve_fits_derivative(model):
+    """I(0) c (d - b) against the difference quotient A*(h) / h of the curve fit (A*(0) = 0)."""
+    b, c, d = M.TABLE_8_4[27]
+    h = 1e-6
+    difference = M.curvefit_area([h], 3.1, b, c, d, model=model)[0] / h
+    assert M.curvefit_slope_at_zero(3.1, b, c, d, model=model) == pytest.approx(difference, rel=1e-5)
+
+
 def test_fit_recovers_a_5_37_curve_made_by_quadrature():
     """b, c, d of a synthetic I f, I of (5.37) with (2.42) by adaptive quad (not the package's rule), are found
     again by the least squares of fit_curvefit with its default I."""

@@ -33,13 +33,13 @@ from .adhesion import (AdhesiveCrack, AdhesiveGW, jkr_G, jkr_pmin, jkr_pstar,
                        nonadhesive_radius, nonadhesive_volume)
 from .complete import COMPLETE_MODELS, complete
 from .curvefit import (ALPHA_P_TABLE_8_3, BGT_SLOPE, CURVEFIT_MODEL, TABLE_8_4, bootstrap_curvefit, correction,
-                       curvefit_area, curvefit_reference, fit_curvefit)
+                       curvefit_area, curvefit_reference, curvefit_slope_at_zero, fit_curvefit)
 from .early import EARLY_MODELS, TABLE_4_1, TABLE_4_1_SEPARATIONS, early, early_area, early_separation
 from .persson import fractal_moments, persson_area, persson_gap, psd_amplitude
 
 __all__ = ["early", "early_area", "early_separation", "complete", "persson_area",
            "persson_gap", "psd_amplitude", "fractal_moments", "curvefit_area", "curvefit_reference",
-           "CURVEFIT_MODEL", "fit_curvefit", "bootstrap_curvefit", "correction", "TABLE_8_4", "ALPHA_P_TABLE_8_3", "BGT_SLOPE",
+           "curvefit_slope_at_zero", "CURVEFIT_MODEL", "fit_curvefit", "bootstrap_curvefit", "correction", "TABLE_8_4", "ALPHA_P_TABLE_8_3", "BGT_SLOPE",
            "EARLY_MODELS", "TABLE_4_1", "TABLE_4_1_SEPARATIONS", "COMPLETE_MODELS", "hertz", "crack", "pdfs", "quadrature",
            "AdhesiveCrack", "AdhesiveGW", "jkr_pstar", "jkr_pmin", "jkr_radius",
            "jkr_G", "jkr_volume", "nonadhesive_radius", "nonadhesive_area",

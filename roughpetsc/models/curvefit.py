@@ -23,7 +23,7 @@ from scipy.optimize import brentq, least_squares
 from .complete import COMPLETE_MODELS, complete
 
 __all__ = ["TABLE_8_4", "ALPHA_P_TABLE_8_3", "BGT_SLOPE", "CURVEFIT_MODEL", "correction", "curvefit_reference",
-           "curvefit_area", "fit_curvefit", "bootstrap_curvefit"]
+           "curvefit_area", "curvefit_slope_at_zero", "fit_curvefit", "bootstrap_curvefit"]
 
 #: Table 8.4: group -> (b, c, d); a = -c.
 TABLE_8_4 = {18: (-1.923, 1.160, -0.062), 19: (-1.924, 1.150, -0.058),
@@ -96,6 +96,28 @@ def curvefit_area(pstar, alpha_p, b, c, d, model=CURVEFIT_MODEL):
     p = np.atleast_1d(np.asarray(pstar, dtype=float))
     I = curvefit_reference(p, alpha_p, model)
     return np.where(p <= P_SPLIT, I * correction(p, b, c, d), I)
+
+
+def curvefit_slope_at_zero(alpha_p, b, c, d, model=CURVEFIT_MODEL):
+    """dA*/dp* of the curve fit (8.2)-(8.3) at p* = 0: I(0) c (d - b), since f(0) = 0.
+
+    Section 8.5 says it is close to sqrt(pi/2) (:data:`BGT_SLOPE`), the asymptotic BGT model's.
+
+    Parameters
+    ----------
+    alpha_p : float
+        Bandwidth of the pressure surface (2.54) that I takes.
+    b, c, d : float
+        Parameters of (8.3), a = -c.
+    model : str or callable
+        I(p*) (:func:`curvefit_reference`).
+
+    Returns
+    -------
+    float
+        The slope [-].
+    """
+    return float(curvefit_reference(np.zeros(1), alpha_p, model)[0]) * c * (d - b)
 
 
 def _continuity_c(b, d):
