@@ -179,6 +179,79 @@ def fig_7_complete(ensembles, produced):
 
 
 COMPLETE_STEPS = (2.0, 2.5, 3.1, 4.0)  # p* of Figs. 7.18-7.21 compared in numbers (the nearest stored step)
+# p* of Figs. 7.11-7.17 compared in numbers, and how far the nearest stored step may lie from each: the early stage
+# (Figs. 7.14-7.17, p* <= 0.2) and the middle of the load history drawn by Figs. 7.11/7.12.
+EARLY_STEPS = ((0.0133, 0.005), (0.05, 0.005), (0.1, 0.01), (0.2, 0.01), (0.5, 0.05), (1.0, 0.05), (1.5, 0.1))
+
+
+def nearest_steps(e, targets):
+    """Indices of the stored steps nearest to each (p*, tolerance) of ``targets`` that lie within the tolerance."""
+    out = []
+    for pstar, tolerance in targets:
+        i = int(np.argmin(np.abs(e.p - pstar)))
+        if abs(e.p[i] - pstar) <= tolerance and i not in out:
+            out.append(i)
+    return out
+
+
+def table_7_early(ensembles, report):
+    """Figs. 7.11-7.17 in numbers: each model's A* and g* over the BEM mean at EARLY_STEPS, with the BEM standard
+    error. The early-contact models give the separation d*, which the figures draw as g* (with the Westergaard
+    kernel the mean gap is the separation, (3.38)); they are stored up to p* = EARLY_PMAX."""
+    read = [preferred(ensembles, g) for g in sorted(GROUPS_7)]
+    read = [e for e in read if e is not None]
+    if not read:
+        return []
+    columns = [("early", name, LABEL[name]) for name in M.EARLY_MODELS] + \
+        [("complete", "greenwood", "Greenwood (nearly complete)"), ("persson", None, "Persson")]
+    report += ["## Figs. 7.11-7.17 in numbers: the models over the BEM, early contact and the middle of the load", "",
+               "Model / BEM mean of A* and of g* at the stored step nearest to each p*, the models at the ensemble's "
+               "mean bandwidths (as drawn); the early-contact models (chapter 4) give d* for g* and are stored up to "
+               f"p* = {EARLY_PMAX:g}. BEM: mean (standard error of the mean, std / sqrt(surfaces)); a ratio is "
+               "significant where it differs from 1 by several times the relative standard error, given last. "
+               "\"corrected / node\": the perimeter-corrected BEM A* over the node-count one, the size of the grid "
+               "effect on A* at that load. The nearly-complete Greenwood model, drawn over the whole history in "
+               f"Figs. 7.11/7.12, is compared beyond p* = {EARLY_PMAX:g} only.", "",
+               "| group | grid, surfaces | quantity | p* | BEM mean (s.e.) | "
+               + " | ".join(label for _, _, label in columns) + " | corrected / node | relative s.e. |",
+               "|---|---|---|---|---|" + "---|" * (len(columns) + 2)]
+    for e in read:
+        steps = nearest_steps(e, EARLY_STEPS)
+        for quantity, mean, std, keys in (("A*", e.A, e.A_std, {"early": "A", "complete": "A", "persson": "A"}),
+                                          ("g*", e.g, e.g_std, {"early": "dstar", "complete": "gstar",
+                                                                "persson": "gstar"})):
+            for i in steps:
+                error = std[i] / np.sqrt(e.n)
+                cells = []
+                for family, name, _ in columns:
+                    y = e.model(family, name, keys[family])
+                    outside = family == "complete" and e.p[i] <= EARLY_PMAX + 1e-12  # drawn, not meant, there
+                    value = None if y is None or outside else y[i]
+                    cells.append("—" if value is None or not np.isfinite(value) or mean[i] == 0
+                                 else f"{value / mean[i]:.3f}")
+                corrected = f"{e.Ac[i] / e.A[i]:.3f}" if quantity == "A*" else "—"
+                report.append(f"| {e.group} | {e.N}^2, {e.n} | {quantity} | {e.p[i]:.3f} | {mean[i]:.4g} "
+                              f"({error:.1g}) | " + " | ".join(cells) + f" | {corrected} | {error / mean[i]:.1e} |")
+    report.append("")
+    return [early_summary(read)]
+
+
+def early_summary(read, pstar=0.05):
+    """One line for the report's summary: each early model's A* / BEM at the step nearest ``pstar``, over the groups."""
+    ratios = {}
+    for e in read:
+        i = int(np.argmin(np.abs(e.p - pstar)))
+        for name in M.EARLY_MODELS + ("persson",):
+            y = e.model("persson", None, "A") if name == "persson" else e.model("early", name, "A")
+            if y is not None and np.isfinite(y[i]):
+                ratios.setdefault(name, []).append(y[i] / e.A[i])
+    return (f"- Early contact (Figs. 7.11-7.17 in numbers, groups {', '.join(str(e.group) for e in read)}): model / "
+            f"BEM A* at p* = {pstar:g}: " + "; ".join(f"{LABEL.get(name, 'Persson')} {min(r):.2f} to {max(r):.2f}"
+                                                   for name, r in ratios.items())
+            + " (relative standard error of the BEM means <= "
+            + f"{max(np.max(e.A_std[e.p <= EARLY_PMAX] / np.sqrt(e.n) / e.A[e.p <= EARLY_PMAX]) for e in read):.1e}"
+            + "; node-count A*, which the perimeter correction lowers by up to "
+            + f"{max(1 - np.min(e.Ac[e.p <= EARLY_PMAX] / e.A[e.p <= EARLY_PMAX]) for e in read):.0%} there).")
 
 
 def table_7_complete(ensembles, report):

@@ -24,6 +24,9 @@ OPTIONS = [
     ("models_hurst", 0.7, "Persson gap: Hurst exponent H in (0, 1)"),
     ("models_m2", 2e-4, "Persson gap: slope moment m2^h > 0"),
     ("models_group", 18, "Table 8.4 group (18-27) for the curve fit (8.2)-(8.3)"),
+    ("models_curvefit_model", "gw", "I(p*) of the curve fit (8.2): gw = adapted GW (5.37) with the PDF (2.42), "
+     "whose curve Table 8.4 is; greenwood = (5.45) with (2.41), as section 8.5 names it; nayak_bush (5.41); "
+     "ciavarella (5.54)"),
     ("models_json", "", "write all curves to this JSON file"),
     ("models_plot", "", "write a PNG of all curves to this file"),
 ]
@@ -43,6 +46,7 @@ class ModelsSettings:
     models_hurst: float
     models_m2: float
     models_group: int
+    models_curvefit_model: str
     models_json: str
     models_plot: str
 
@@ -67,9 +71,13 @@ def _validate(o):
         raise UserError("-models_ks must exceed -models_kl")
     if not 0 < o.models_hurst < 1:
         raise UserError("-models_hurst must lie in (0, 1) (got %r)" % o.models_hurst)
+    from .complete import COMPLETE_MODELS
     from .curvefit import TABLE_8_4
     if o.models_group not in TABLE_8_4:
         raise UserError("-models_group must be one of %s" % sorted(TABLE_8_4))
+    if o.models_curvefit_model not in COMPLETE_MODELS:
+        raise UserError("-models_curvefit_model must be one of %s (got %r)"
+                        % (", ".join(COMPLETE_MODELS), o.models_curvefit_model))
 
 
 def compute(o):
@@ -92,11 +100,11 @@ def compute(o):
                       "gstar_pstar": pp.tolist(),
                       "gstar": persson_gap(pp, o.models_kl, o.models_ks, o.models_hurst,
                                            o.models_m2, 1.0).tolist()}
-    grp = o.models_group
+    grp, model = o.models_group, o.models_curvefit_model
     b, c, dd = TABLE_8_4[grp]
-    out["curvefit"] = {"group": grp, "b": b, "c": c, "d": dd, "alpha_p": ALPHA_P_TABLE_8_3[grp],
+    out["curvefit"] = {"group": grp, "model": model, "b": b, "c": c, "d": dd, "alpha_p": ALPHA_P_TABLE_8_3[grp],
                        "pstar": p.tolist(),
-                       "A": curvefit_area(p, ALPHA_P_TABLE_8_3[grp], b, c, dd).tolist()}
+                       "A": curvefit_area(p, ALPHA_P_TABLE_8_3[grp], b, c, dd, model=model).tolist()}
     return out
 
 
@@ -112,7 +120,7 @@ def plot(curves, path):
         ax[1].semilogy(c["pstar"][1:], c["gstar"][1:], "--", label=name)
     ax[0].plot(curves["persson"]["pstar"], curves["persson"]["A"], "k:", label="Persson")
     ax[0].plot(curves["curvefit"]["pstar"], curves["curvefit"]["A"], "k-", lw=2,
-               label="curve fit (group %d)" % curves["curvefit"]["group"])
+               label="curve fit (group %d, I = %s)" % (curves["curvefit"]["group"], curves["curvefit"]["model"]))
     ax[1].semilogy(curves["persson"]["gstar_pstar"], curves["persson"]["gstar"], "k:", label="Persson")
     ax[0].set(xlabel="p*", ylabel="A*", ylim=(0, 1.02),
               title="alpha^h = %g, alpha^p = %g" % (curves["alpha_h"], curves["alpha_p"]))
@@ -154,6 +162,11 @@ def _compute_and_write(o):
     for name, c in curves["complete"].items():
         for i in (len(c["pstar"]) // 2, -1):
             print("%-16s %10.4f %10.4e %10.4e" % (name, c["pstar"][i], c["A"][i], c["gstar"][i]))
+    fit = curves["curvefit"]
+    print("curve fit (8.2)-(8.3), Table 8.4 group %d (b, c, d = %g, %g, %g), I = %s at alpha_p = %g:"
+          % (fit["group"], fit["b"], fit["c"], fit["d"], fit["model"], fit["alpha_p"]))
+    for i in (len(fit["pstar"]) // 4, len(fit["pstar"]) // 2):
+        print("%-16s %10.4f %10.4e" % ("curve fit", fit["pstar"][i], fit["A"][i]))
     if o.models_json:
         with atomic_path(o.models_json) as tmp:
             with open(tmp, "w") as fh:
