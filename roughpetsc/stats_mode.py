@@ -24,12 +24,12 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from . import asperities, mode_settings, seeds, spectra
+from . import asperities, mode_settings, seeds, spectra, surfaces
 from .errors import ParameterError, UserError
 from .io import check_outputs, on_root
 from .mode_settings import Option
 from .stats_output import FIELDS, closed_form_pdfs, report, result_document
-from .surfaces import SURFACE_OPTIONS, fractal_amplitude, from_options
+from .surfaces import fractal_amplitude, from_options
 
 OPTIONS = [
     Option("stats_ensemble", 0, "number of realisations (seeds from -ensemble_seed, as in -mode ensemble); 0 = "
@@ -99,8 +99,12 @@ def output_paths(settings):
 
 
 def surface_settings(options):
-    """The surface options as read (for the record): ``{name: value}``, typed by their defaults."""
-    return mode_settings.read_table(options, SURFACE_OPTIONS)
+    """The surface options this run uses, as read (for the record): ``{name: value}``, typed by their defaults.
+
+    Those of the surface type (:func:`roughpetsc.surfaces.parameters`), so that one the run does not use
+    is reported as unused.
+    """
+    return surfaces.parameters(options)
 
 
 def histogram_edges(bin_width):
@@ -269,11 +273,12 @@ def pdf_distances(summary):
 # Entry point
 # ----------------------------------------------------------------------------
 
-def compute(options, comm):
-    """Compute the statistics on all ranks; the result document on rank 0, None elsewhere."""
-    settings = read_settings(options)
+def compute(options, comm, settings, surface):
+    """Compute the statistics on all ranks; the result document on rank 0, None elsewhere.
+
+    ``settings`` are :func:`read_settings` of ``options``, ``surface`` :func:`surface_settings`.
+    """
     record = settings.record()
-    surface = surface_settings(options)
     realisation_seeds = surface_seeds(settings)
     edges = histogram_edges(settings.bin_width)
     try:
@@ -302,13 +307,14 @@ def run(options, comm):
     The result document (dict) on rank 0, None on the other ranks.
     Raises :class:`UserError` on bad input (on every rank).
     """
+    from .options import check_unused  # imports PETSc: only once the command line has initialised it
+
     settings = read_settings(options)
+    surface = surface_settings(options)
     # Rank 0 checks the files and writes them; a failure there is raised on every rank (no rank left waiting).
     on_root(comm, check_outputs, output_paths(settings), options.getBool("overwrite", False),
             [("surface_file", options.getString("surface_file", ""))])
-    document = compute(options, comm)
+    check_unused()  # before any work: a run refused for an option it does not use computes and writes nothing
+    document = compute(options, comm, settings, surface)
     on_root(comm, report, document)
-    from .options import check_unused  # imports PETSc: only once the command line has initialised it
-
-    check_unused()
     return document
