@@ -59,6 +59,10 @@ class ContactProblem:
     progress : callable or None
         Called as ``progress(iteration, natural_residual, seconds)`` with every residual that a
         solver of this problem records (:class:`~roughpetsc.kkt.History`); None by default.
+    stop_requested : callable or None
+        ``stop_requested()`` is True when this process was asked to stop (Ctrl-C,
+        :class:`roughpetsc.interrupts.StopRequests`); every solve then ends at its next iteration, on
+        every rank alike (:meth:`~roughpetsc.kkt.History.out_of_time`). Set it on every rank or none.
     """
 
     def __init__(self, grid, heights, E_star, comm=None, fft_threads=1, fft_effort="FFTW_MEASURE",
@@ -103,6 +107,7 @@ class ContactProblem:
         self.upper_bound = None if hardness is None else hardness / self.pressure_scale
         self.max_height = float(-allmin(self.mpi, [-self.local(self.heights, readonly=True).max()])[0])
         self.progress = None
+        self.stop_requested = None
 
     # --- vectors and fields -------------------------------------------------
     def vec(self):
