@@ -4,7 +4,6 @@ printed and says so in one line; Ctrl-C in ensemble mode; a closed pipe; progres
 import hashlib
 import json
 import os
-import pty
 import signal
 import subprocess
 import sys
@@ -13,7 +12,7 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import MPI_ENV, ROOT, run_cli
+from conftest import MPI_ENV, ROOT, run_cli, run_on_terminal
 from test_newcomer import assert_one_clear_error
 
 TINY = ["-surface_N", 32, "-surface_ks", 8, "-surface_kl", 2, "-fft_effort", "FFTW_ESTIMATE"]
@@ -168,25 +167,6 @@ def test_output_into_a_pipe_closed_early_ends_quietly(tmp_path):
 
 
 # --- progress lines: only for a person watching, each naming its step and inner solve --------------------------
-
-def run_on_terminal(command, cwd):
-    """Run ``command`` with stdout on a pseudo-terminal; returns (exit status, what it printed)."""
-    primary, secondary = pty.openpty()
-    run = subprocess.Popen(command, stdout=secondary, stderr=subprocess.PIPE, cwd=cwd,
-                           env=dict(os.environ, **MPI_ENV, PYTHONPATH=ROOT))
-    os.close(secondary)
-    printed = b""
-    while True:
-        try:
-            chunk = os.read(primary, 4096)
-        except OSError:  # the terminal closed with the process
-            break
-        if not chunk:
-            break
-        printed += chunk
-    os.close(primary)
-    return run.wait(timeout=300), printed.decode()
-
 
 PROGRESS = TINY + ["-pstar_list", "0.2,0.4", "-progress_interval", 1e-9]
 
