@@ -204,7 +204,8 @@ def read_physics(reader):
             check_depths(depths)
         check_poisson(values["nu"])
     return {"boundary": values["boundary"], "hardness": hardness or None, "stress_depths": depths,
-            "nu": values["nu"], "adhesion": adhesive_options.read_law(values)}
+            "nu": values["nu"],
+            "adhesion": adhesive_options.read_law(values, {name for name in values if reader.has(name)})}
 
 
 def check_files(settings, comm):
@@ -465,7 +466,8 @@ def write_outputs(settings, record, grid, fields, with_h5=True):
     if settings.plot and not fields:  # every step taken from a file without fields
         print(f"roughpetsc: -plot: no fields to plot in {settings.output} (-output_fields none)", file=sys.stderr)
     elif settings.plot:
-        plots.plot_solution(settings.plot, grid, fields["pressure"], fields["gap"], record.steps)
+        adhesion = record.summary["adhesion"] if settings.adhesion is not None else None
+        plots.plot_solution(settings.plot, grid, fields["pressure"], fields["gap"], record.steps, adhesion)
 
 
 def step_line(step):
