@@ -311,7 +311,10 @@ def run(reader, comm):
 
 
 def build_problem(settings, reader, comm):
-    """``(grid, heights, problem)`` of the options: the surface, then the ContactProblem on every rank."""
+    """``(grid, heights, problem, levelling)`` of the options: the surface, then the ContactProblem on every rank.
+
+    ``levelling``: the :class:`roughpetsc.surfaces.Levelling` of a surface file, None for a generated surface.
+    """
     from petsc4py import PETSc
 
     from . import fftw, surfaces
@@ -323,11 +326,12 @@ def build_problem(settings, reader, comm):
     if not settings.surface_file:
         # Before the surface is built: a grid with fewer rows than ranks is refused by name.
         row_split(surfaces.grid_from_options(reader).n0, comm.Get_size())
-    grid, heights = surfaces.from_options(reader)
+    levelling = []
+    grid, heights = surfaces.from_options(reader, notes=levelling)
     with fftw.remembered_plans(comm, wisdom, effort), options_named():
         problem = ContactProblem(grid, heights, settings.E_star, PETSc.COMM_WORLD, settings.fft_threads, effort,
                                  boundary=settings.boundary, hardness=settings.hardness)
-    return grid, heights, problem
+    return grid, heights, problem, (levelling[0] if levelling else None)
 
 
 def solve_settings(settings, reader, comm, requests):
@@ -338,7 +342,7 @@ def solve_settings(settings, reader, comm, requests):
     from .surface_moments import surface_moments
 
     say = printer(settings.quiet, comm)
-    grid, heights, problem = build_problem(settings, reader, comm)
+    grid, heights, problem, levelling = build_problem(settings, reader, comm)
     solver = None
     try:
         problem.stop_requested = requests.is_set
@@ -353,6 +357,8 @@ def solve_settings(settings, reader, comm, requests):
                    "boundary": settings.boundary, "hardness": settings.hardness or 0.0,
                    "adhesion": adhesive_options.summary(settings.adhesion, statistics, settings.E_star),
                    "ranks": comm.Get_size(), **io.provenance()}
+        if levelling is not None:
+            summary["surface_levelling"] = levelling.record()
         # Fields written by every rank into its rows where h5py is the parallel build (store.write_distributed).
         distributed = bool(settings.output) and settings.output_fields != "none" and store.parallel_hdf5(comm)
         rows = problem.local_rows
@@ -363,6 +369,8 @@ def solve_settings(settings, reader, comm, requests):
             if start is not None:  # the next solve scales it to its load (Solver's warm start)
                 problem.local(solver.pressure)[...] = start[problem.local_rows] / problem.pressure_scale
         say_header(settings, grid, problem, solver, statistics, summary, say)
+        if levelling is not None:
+            report_levelling(levelling, settings.surface_file, say, comm)
         for step in record.steps:
             say(step_line(step) + f"  (from {settings.output})")
         lines = StepLines(say, hold=bool(settings.output or settings.json))
@@ -397,6 +405,15 @@ def say_header(settings, grid, problem, solver, statistics, summary, say):
         say(adhesive_options.header(settings.adhesion, summary["adhesion"]))
     say(f"{'p*':>10} {'A*':>10} {'A*corr':>10} {'g*':>11} {'KKT nat':>9} {'its':>6} {'Kapps':>6} "
         f"{'time s':>8}  reason")
+
+
+def report_levelling(levelling, path, say, comm):
+    """Rank 0: what levelling a surface file did (stdout) and its warnings (stderr), one line each."""
+    for note in levelling.notes:
+        if note.startswith("warning: ") and comm.Get_rank() == 0:
+            print(f"roughpetsc: warning: -surface_file {path}: {note[len('warning: '):]}", file=sys.stderr, flush=True)
+        elif not note.startswith("warning: "):
+            say(f"  surface: {note}")
 
 
 def report_interruption(settings, record):
