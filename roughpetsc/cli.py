@@ -177,6 +177,14 @@ def check_memory(reader, comm, mode):
                         f"more machines")
 
 
+def hide_unused_petsc_stages():
+    """-log_view: PETSc 3.18 registers a stage PCMPI (its MPI linear-solver server, which roughpetsc never starts)
+    that -log_view lists, empty, as an anonymous stage 'Unknown'; it is hidden, so every stage shown is named."""
+    from petsc4py import PETSc
+
+    PETSc.Log.Stage("PCMPI").visible = False
+
+
 def print_version():
     """``-version``: roughpetsc's version, then PETSc's and the rest of the stack's (after PETSc starts)."""
     from . import __version__
@@ -207,6 +215,8 @@ def main(argv=None):
         argv = [item for item in argv if item not in ("-version", "--version")]
     petsc4py.init(argv)
     from petsc4py import PETSc
+
+    hide_unused_petsc_stages()
 
     from .options import Reader, check_names, check_values_given, translate_renamed_options
 

@@ -64,7 +64,8 @@ def allmax(comm, values):
     return _allreduce(comm, values, "MAX")
 
 
-@PETSc.Log.EventDecorator("RPKKTCheck")  # -log_view: the residual check of every iteration
+# -log_view: every call (the certificate of each result; each iteration of the TAO types' convergence test)
+@PETSc.Log.EventDecorator("RPKKTCheck")
 def report(comm, pressure, gap, n_total, target_pbar=None, upper=None):
     """KKT report of local arrays ``pressure``, ``gap`` (scaled units, rms height 1).
 
