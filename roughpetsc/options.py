@@ -6,6 +6,7 @@ import difflib
 import functools
 import glob
 import os
+import re
 import warnings
 
 from petsc4py import PETSc
@@ -253,16 +254,33 @@ def read_late(name):
     return "view" in name or "converged_reason" in name
 
 
-def check_unused(ignore=(), final=True):
+# Options of the parts of a TAO that a solver never runs (its line search, its KSP and PC, another TAO type's):
+# PETSc reads them into the objects every TAO creates, so they count as used although nothing uses them.
+PARTS_UNUSED_BY_PYTHON_TAO = re.compile(
+    r"^(tao_ls_|tao_ksp_|tao_pc_|ksp_|pc_|tao_(bnk|bqnk|bncg|bqnls|blmvm|lmvm|almm|gpcg|tron|bnls|bntr|bntl|nls|ntr|"
+    r"ntl|owlqn|bmrm|pounders|brgn|admm|ipm|pdipm|cg|nm|lcl)_|tao_subset_type)")
+
+
+def given_but_unusable(pattern, prefix=None):
+    """The options given (with ``prefix``) whose names match ``pattern`` after the prefix: read, never used."""
+    prefix = prefix or ""
+    return [name for name in PETSc.Options().getAll()
+            if name.startswith(prefix) and pattern.match(name[len(prefix):])]
+
+
+def check_unused(ignore=(), final=True, unusable=()):
     """Raise :class:`UserError` if an option was given that nothing used (a misspelling, say).
 
     With ``final=False`` (before a solve) options that PETSc reads only during
     or after the solve (:func:`read_late`) are skipped, so a misspelling fails
     before the work and a late option is checked by the final call after it.
+    ``unusable`` names options that were read but that the run cannot use (the line search or KSP of a
+    solver that has none, :func:`given_but_unusable`): reported like the unused ones.
     """
     unused = unused_options()
     if unused is None:  # cannot be checked here: unused_options has said so
         return
+    unused = list(unused) + [name for name in unusable if name not in unused]
     left = [name for name in unused
             if name not in ignore and name not in FINALIZE_OPTIONS and (final or not read_late(name))]
     if left:

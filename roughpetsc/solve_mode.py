@@ -349,7 +349,8 @@ def solve_settings(settings, reader, comm, requests):
         problem.progress = progress_printer(settings, comm)
         statistics = surface_moments(grid, heights, settings.E_star)
         solver = make_solver(settings, problem)
-        check_unused(final=False)  # misspellings fail now; options PETSc reads after a solve are checked then
+        unusable = getattr(solver, "unusable_options", list)()
+        check_unused(final=False, unusable=unusable)  # misspellings fail now; those read after a solve, then
         summary = {"grid": [grid.n0, grid.n1], "length": [grid.l0, grid.l1], "E_star": settings.E_star,
                    "surface": statistics, "surface_parameters": dict(surfaces.parameters(reader), surface_L=grid.l1),
                    "sqrt_m0h": problem.sqrt_m0h, "sqrt_m0p": problem.sqrt_m0p,
