@@ -210,7 +210,9 @@ def load(path):
 
     HDF5: the dataset ``surface`` (contact-mechanics-challenge layout) or
     ``heights`` (a roughpetsc output, whose root attribute ``length`` records
-    the cell size ``[l0, l1]``). CSV (``.csv``, commas) and text (blanks) hold
+    the cell size ``[l0, l1]``). Other suffixes than those of :data:`TABLE_SUFFIXES`
+    are instrument files, read by SurfaceTopography (:func:`read_instrument`).
+    CSV (``.csv``, commas) and text (blanks) hold
     a height matrix (rows along y, at least 4 columns) or an ``x y z`` point
     list (three columns, one point a line) whose points lie on a uniform grid of
     square nodes (:func:`points_to_grid`); one header line of words is skipped.
@@ -240,13 +242,21 @@ def load(path):
         raise ParameterError("path", f"{path}: {error}") from None
 
 
+# Files read as tables (a height matrix or an x y z point list) by their suffix; HDF5 and .npy by their own
+# readers; any other suffix by SurfaceTopography when that optional extra is installed (tools/surfacetopography.sh).
+TABLE_SUFFIXES = (".txt", ".csv", ".dat", ".asc", ".xyz", "")
+HDF5_SUFFIXES = (".h5", ".hdf5", ".hdf")
+
+
 def _read_array(path):
     """``(heights as stored, recorded length or None)`` of a surface file, by its suffix."""
     suffix = os.path.splitext(path)[1].lower()
     if suffix == ".npy":
         return np.load(path, allow_pickle=False), None
-    if suffix not in (".h5", ".hdf5", ".hdf"):
+    if suffix in TABLE_SUFFIXES:
         return table_surface(read_table(path), path)
+    if suffix not in HDF5_SUFFIXES:
+        return read_instrument(path)
     import h5py
 
     with h5py.File(path, "r") as f:
@@ -256,6 +266,39 @@ def _read_array(path):
             length = float(json.loads(f.attrs["length"])[1]) if "length" in f.attrs else None
             return f["heights"][()], length
     raise ParameterError("path", f"{path}: no dataset 'surface' or 'heights' in the HDF5 file")
+
+
+def read_instrument(path):
+    """``(heights, cell length along x or None)`` of an instrument file, read by SurfaceTopography.
+
+    Rows of the result run along y. The length is the file's physical size along x (in the unit of
+    its heights), None where the file records none. Without SurfaceTopography (an optional extra,
+    ``bash tools/surfacetopography.sh``) the file is read as a table if it is one, else refused.
+    """
+    try:
+        from SurfaceTopography import open_topography
+    except ImportError:
+        try:
+            return table_surface(read_table(path), path)
+        except (ParameterError, UnicodeDecodeError):
+            raise ParameterError("path", f"{path}: not a format roughpetsc reads (.npy, HDF5, text, CSV); instrument "
+                                         "formats are read by SurfaceTopography, an optional extra: bash "
+                                         "tools/surfacetopography.sh") from None
+    reader = open_topography(path)
+    channel = reader.default_channel
+    sizes = channel.physical_sizes
+    # A file that records its physical sizes fixes them; one that does not gets unit node spacing.
+    topography = reader.topography() if sizes is not None else reader.topography(physical_sizes=channel.nb_grid_pts)
+    if topography.dim != 2 or not getattr(topography, "is_uniform", True):
+        raise ParameterError("path", f"{path}: a line scan or non-uniform data, not a surface on a grid")
+    heights = np.asarray(topography.heights()).T  # SurfaceTopography: axis 0 = x
+    if sizes is None:
+        return heights, None
+    nx, ny = channel.nb_grid_pts
+    if abs(sizes[0] / nx - sizes[1] / ny) > 1e-6 * sizes[0] / nx:
+        raise ParameterError("path", f"{path}: nodes {sizes[0] / nx:.6g} apart along x and {sizes[1] / ny:.6g} along "
+                                     "y: the grid needs square nodes")
+    return heights, float(sizes[0])
 
 
 def read_table(path):
@@ -500,8 +543,8 @@ def square_grid(n1, n0=0, length=1.0):
 SURFACE_OPTIONS = [
     ("surface_type", "fractal", "fractal | bisinusoid | wave | sphere (an error with -surface_file)"),
     ("surface_file", "", "read heights from PATH: .npy, a text or CSV height matrix or x y z point list on a grid, "
-                         ".h5/.hdf5 dataset 'surface', or a roughpetsc output (dataset 'heights' and its recorded "
-                         "cell length)"),
+                         ".h5/.hdf5 dataset 'surface', a roughpetsc output (dataset 'heights' and its recorded "
+                         "cell length), or an instrument file (with the optional SurfaceTopography)"),
     ("surface_detrend", "mean", "-surface_file: none | mean | plane (remove the least-squares plane, reported); a "
                                 "tilt or a jump between opposite edges large against the rms height is warned of"),
     ("surface_N", 256, "nodes per side (N x N grid)"),

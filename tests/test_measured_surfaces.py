@@ -216,3 +216,34 @@ def test_the_api_refuses_bad_input_at_construction(build, parameter):
     with pytest.raises(ParameterError) as raised:
         build()
     assert raised.value.parameter == parameter
+
+
+# --- instrument files through SurfaceTopography (the optional extra, tools/surfacetopography.sh) ------------------
+
+def test_an_instrument_file_is_read_by_surfacetopography(tmp_path):
+    """A NetCDF topography written by SurfaceTopography itself: heights (x along axis 0 there) and size."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        from SurfaceTopography import Topography
+
+        heights = np.random.default_rng(0).standard_normal((48, 32)) * 1e-4  # (nx, ny)
+        Topography(heights, physical_sizes=(1.5, 1.0)).to_netcdf(str(tmp_path / "s.nc"))
+    read, length = load_surface(str(tmp_path / "s.nc"))
+    assert read.shape == (32, 48) and length == 1.5
+    assert np.allclose(read, heights.T - heights.mean(), rtol=0, atol=1e-18)
+    out = run_cli(["-surface_file", "s.nc", "-json", "s.json", "-quiet"] + SOLVE, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert json.load(open(tmp_path / "s.json"))["length"] == [1.0, 1.5]
+
+
+def test_without_the_extra_an_instrument_file_is_refused_naming_it(tmp_path, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "SurfaceTopography", None)  # import fails as where it is not installed
+    (tmp_path / "scan.opd").write_bytes(b"\x00\x01binary instrument data\xff")
+    with pytest.raises(ParameterError, match="SurfaceTopography, an optional extra: bash tools/surfacetopography.sh"):
+        load_surface(str(tmp_path / "scan.opd"))
+    np.savetxt(tmp_path / "matrix.asc2", periodic_heights())  # an unknown suffix holding a table: read as one
+    assert load_surface(str(tmp_path / "matrix.asc2"))[0].shape == (32, 32)
