@@ -78,6 +78,9 @@ class RootFind(Backend):
             side = "above" if mean_p > pbar else "below"  # the closest solutions on each side of the load
             pressure.copy(self.bracket[side])
             state[side] = (d, mean_p)
+            if outcome.reason.startswith("DIVERGED_USER (time limit"):  # the inner solve spent the search's time
+                state["stop"] = "DIVERGED_USER"
+                raise Found
             if abs(mean_p - pbar) <= self.rtol * pbar:
                 if not outcome.reason.startswith("CONVERGED"):
                     state["stop"] = "DIVERGED_ROOT_INNER"  # the load is met, the inner QP is not solved
