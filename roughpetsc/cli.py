@@ -197,6 +197,16 @@ def print_version():
 
 
 def main(argv=None):
+    """The command line: the exit status. Ctrl-C before a mode can keep any work ends in one line (status 130)."""
+    try:
+        return run_command_line(argv)
+    except KeyboardInterrupt:  # while Python or PETSc start, before a mode runs
+        if launcher_rank() == 0:
+            print("roughpetsc: interrupted", file=sys.stderr, flush=True)
+        return 130
+
+
+def run_command_line(argv=None):
     import petsc4py
 
     from .terminal import ClosedPipeTolerant
