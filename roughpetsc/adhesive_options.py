@@ -17,13 +17,31 @@ OPTIONS = [
 ]
 
 
-def read_law(values):
-    """The law of ``-adhesion`` from the option values (None for none); a missing parameter is refused by name."""
+PARAMETERS = ("adhesion_work", "adhesion_stress", "adhesion_range")
+
+
+def read_law(values, given):
+    """The law of ``-adhesion`` from the option values (None for none), each parameter as the user gave it.
+
+    ``given`` is the set of option names given. A parameter of no law (no ``-adhesion``), one the law
+    does not take (``-adhesion_stress`` of the exponential law) and ``-adhesion_range`` with
+    ``-adhesion_stress`` (two settings of the Dugdale range) are refused; a missing or bad one is
+    refused by :func:`roughpetsc.interaction.make_law`, quoting the value given.
+    """
     from .interaction import make_law
 
+    kind = values["adhesion"]
+    parameters = [name for name in PARAMETERS if name in given]
+    if kind == "none" and parameters:
+        raise UserError(f"{', '.join('-' + name for name in parameters)} given without -adhesion: choose a law "
+                        "(-adhesion dugdale or exponential), or leave the parameters out")
+    if kind == "dugdale" and {"adhesion_stress", "adhesion_range"} <= given:
+        raise UserError("-adhesion_stress and -adhesion_range both set the Dugdale range (h0 = w / sigma0): give "
+                        "one of them")
+    if kind == "exponential" and "adhesion_stress" in given:
+        raise UserError("-adhesion_stress: the exponential law takes -adhesion_range (its peak stress is w / rho)")
     with options_named():
-        return make_law(values["adhesion"], values["adhesion_work"] or None, values["adhesion_stress"] or None,
-                        values["adhesion_range"] or None)
+        return make_law(kind, *(values[name] if name in given else None for name in PARAMETERS))
 
 
 def check(settings):

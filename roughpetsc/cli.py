@@ -27,14 +27,17 @@ from .presets import PRESET_FOLDERS, ROOT, preset_names
 MODES = {"solve": solve_mode, "stats": stats_mode, "models": models_mode, "ensemble": ensemble}
 
 
-def all_option_names():
-    """The names of every option of roughpetsc (general, surface, each mode's)."""
+def all_options():
+    """``{name: default}`` of every option of roughpetsc (general, surface, each mode's)."""
     from .surfaces import SURFACE_OPTIONS
 
-    names = {name for name, _, _ in GENERAL_OPTIONS + SURFACE_OPTIONS}
-    for module in MODES.values():
-        names.update(name for name, _, _ in module.OPTIONS)
-    return names
+    table = GENERAL_OPTIONS + SURFACE_OPTIONS + [option for module in MODES.values() for option in module.OPTIONS]
+    return {name: default for name, default, _ in table}
+
+
+def all_option_names():
+    """The names of every option of roughpetsc (general, surface, each mode's)."""
+    return set(all_options())
 
 
 def format_help(title, option_table):
@@ -73,8 +76,9 @@ def resolve_presets(argv):
     PETSc reads the files when it is initialised, so this runs before; a
     preset named from another folder (``-options_file solvers/pk.opts``) or by
     its bare name (``-options_file pk``) is found in the repository. Returns
-    ``(argv, message)``: a file found nowhere is dropped from ``argv`` and
-    ``message`` names it (raised once PETSc can report it on rank 0).
+    ``(argv, message)``: a file found nowhere, or one that is not an options file
+    (:func:`options_file_error`), is dropped from ``argv`` and ``message`` names it
+    (raised once PETSc can report it on rank 0).
     """
     resolved, message = list(argv[:1]), None
     items = iter(argv[1:])
@@ -87,12 +91,38 @@ def resolve_presets(argv):
         candidates += [os.path.join(ROOT, folder, name) for folder in PRESET_FOLDERS
                        for name in (path, path + ".opts")]
         found = next((c for c in candidates if path and os.path.isfile(c)), None)
-        if found is None:
-            message = message or (f"-options_file {path}: no such file (looked in the current folder and in {ROOT}; "
-                                  f"-help lists the presets)" if path else "-options_file: give a file name")
+        problem = options_file_error(path, found)
+        if problem:
+            message = message or problem
             continue
         resolved += [item, found]
     return resolved, message
+
+
+def options_file_error(path, found):
+    """Why ``-options_file path`` (found at ``found``, or None) cannot be given to PETSc, or None if it can.
+
+    PETSc stops with an error dump on a file whose lines do not begin with an option; each line must
+    be blank, a ``#`` comment, ``-name [value]`` or ``alias -new -old``.
+    """
+    if not path:
+        return "-options_file: give a file name"
+    if found is None:
+        return (f"-options_file {path}: no such file (looked in the current folder and in {ROOT}; -help lists the "
+                "presets)")
+    try:
+        with open(found, encoding="utf-8") as handle:
+            lines = handle.read().splitlines()
+    except (OSError, UnicodeDecodeError) as error:
+        reason = getattr(error, "strerror", None) or "not a text file"
+        return f"-options_file {path}: cannot read it as an options file ({reason})"
+    for number, line in enumerate(lines, 1):
+        words = line.split("#", 1)[0].split()
+        if words and not (words[0].startswith("-") or words[0] == "alias"):
+            shown = line.strip() if len(line.strip()) <= 60 else line.strip()[:57] + "..."
+            return (f"-options_file {path}: line {number} '{shown}' is not an option (an options file holds "
+                    "'-name value' lines and # comments)")
+    return None
 
 
 def launcher_rank():
@@ -147,8 +177,39 @@ def check_memory(reader, comm, mode):
                         f"more machines")
 
 
+def hide_unused_petsc_stages():
+    """-log_view: PETSc 3.18 registers a stage PCMPI (its MPI linear-solver server, which roughpetsc never starts)
+    that -log_view lists, empty, as an anonymous stage 'Unknown'; it is hidden, so every stage shown is named."""
+    from petsc4py import PETSc
+
+    PETSc.Log.Stage("PCMPI").visible = False
+
+
+def print_version():
+    """``-version``: roughpetsc's version, then PETSc's and the rest of the stack's (after PETSc starts)."""
+    from . import __version__
+    from .io import versions
+
+    found = versions()
+    stack = ", ".join(f"{'PETSc' if name == 'petsc' else name} {version}" for name, version in found.items()
+                      if name != "roughpetsc")
+    print(f"roughpetsc {__version__}\n{stack}", flush=True)
+
+
 def main(argv=None):
+    """The command line: the exit status. Ctrl-C before a mode can keep any work ends in one line (status 130)."""
+    try:
+        return run_command_line(argv)
+    except KeyboardInterrupt:  # while Python or PETSc start, before a mode runs
+        if launcher_rank() == 0:
+            print("roughpetsc: interrupted", file=sys.stderr, flush=True)
+        return 130
+
+
+def run_command_line(argv=None):
     import petsc4py
+
+    from .terminal import ClosedPipeTolerant
 
     # Before PETSc starts: it reads the options files, and prints its own -help, as it is initialised.
     argv, preset_error = resolve_presets(sys.argv if argv is None else argv)
@@ -159,20 +220,37 @@ def main(argv=None):
         argv = [*argv, "-no_signal_handler"]
         if launcher_rank() == 0:
             print_help()
+    version = any(item in ("-version", "--version") for item in argv[1:])
+    if version:  # PETSc's banner would come first and the run go on; our line names both versions instead
+        argv = [item for item in argv if item not in ("-version", "--version")]
     petsc4py.init(argv)
     from petsc4py import PETSc
 
-    from .options import Reader, check_names, translate_renamed_options
+    hide_unused_petsc_stages()
 
+    from .options import Reader, check_names, check_values_given, translate_renamed_options
+
+    # A reader that closes the pipe early (| head) ends the printing, not the run: no SIGPIPE abort of
+    # PETSc's handler, no BrokenPipeError; the files are still written.
+    signal.signal(signal.SIGPIPE, signal.SIG_IGN)
+    # A batch system's time limit (SIGTERM, also what mpiexec sends its ranks on Ctrl-C) ends a run like
+    # Ctrl-C, not in PETSc's handler: the finished work is kept and one line says so.
+    signal.signal(signal.SIGTERM, signal.default_int_handler)
+    sys.stdout = ClosedPipeTolerant(sys.stdout)
     comm = PETSc.COMM_WORLD.tompi4py()
     reader = Reader()
     try:
         if reader.has("help"):
             return 0
+        if version:
+            if comm.Get_rank() == 0:
+                print_version()
+            return 0
         if preset_error:
             raise UserError(preset_error)
         translate_renamed_options()
         check_names(all_option_names())
+        check_values_given(all_options())
         reader.bool("quiet", False)  # every mode's option (read here, so that no mode reports it unused)
         mode = reader.string("mode", "solve")
         if mode not in MODES:
@@ -188,6 +266,10 @@ def main(argv=None):
         if comm.Get_rank() == 0:
             print(f"roughpetsc: PETSc error: {error}", file=sys.stderr, flush=True)
         return 2
+    except KeyboardInterrupt:  # a mode that keeps finished work says so itself; here nothing was kept
+        if comm.Get_rank() == 0:
+            print("roughpetsc: interrupted", file=sys.stderr, flush=True)
+        return 130
     except MemoryError:
         print("roughpetsc: error: out of memory (use a smaller grid or more machines)", file=sys.stderr, flush=True)
         if comm.Get_size() > 1:  # this rank alone may have failed: stop the others rather than leave them waiting

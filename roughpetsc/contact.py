@@ -59,6 +59,10 @@ class ContactProblem:
     progress : callable or None
         Called as ``progress(iteration, natural_residual, seconds)`` with every residual that a
         solver of this problem records (:class:`~roughpetsc.kkt.History`); None by default.
+    stop_requested : callable or None
+        ``stop_requested()`` is True when this process was asked to stop (Ctrl-C,
+        :class:`roughpetsc.interrupts.StopRequests`); every solve then ends at its next iteration, on
+        every rank alike (:meth:`~roughpetsc.kkt.History.out_of_time`). Set it on every rank or none.
     """
 
     def __init__(self, grid, heights, E_star, comm=None, fft_threads=1, fft_effort="FFTW_MEASURE",
@@ -67,10 +71,20 @@ class ContactProblem:
             raise ParameterError("boundary", f"the boundary is one of {', '.join(BOUNDARIES)}, got '{boundary}'")
         if hardness is not None and not (hardness > 0 and math.isfinite(hardness)):
             raise ParameterError("hardness", f"the hardness must be positive and finite, got {hardness}")
-        if not (E_star > 0 and math.isfinite(E_star)):
-            raise ParameterError("E_star", f"the composite modulus must be positive and finite, got {E_star}")
+        if not (isinstance(E_star, (int, float, np.integer, np.floating)) and E_star > 0 and math.isfinite(E_star)):
+            raise ParameterError("E_star", f"the composite modulus must be positive and finite, got {E_star!r}")
+        if not isinstance(grid, Grid):
+            raise ParameterError("grid", f"the grid must be a roughpetsc Grid, got {type(grid).__name__}")
         if np.shape(heights) != grid.shape:
             raise ParameterError("heights", f"the heights have shape {np.shape(heights)}, the grid {grid.shape}")
+        heights = np.asarray(heights)
+        if not np.issubdtype(heights.dtype, np.number) or np.iscomplexobj(heights):
+            raise ParameterError("heights", f"the heights must be real numbers, got dtype {heights.dtype}")
+        if not np.all(np.isfinite(heights)):
+            raise ParameterError("heights", f"{int(np.count_nonzero(~np.isfinite(heights)))} height(s) are NaN or "
+                                            "infinite")
+        if np.ptp(heights) == 0:
+            raise ParameterError("heights", "the surface is flat (all heights equal): there is no contact problem")
         self.comm = comm or PETSc.COMM_WORLD
         self.mpi = self.comm.tompi4py()
         self.grid = grid
@@ -103,6 +117,7 @@ class ContactProblem:
         self.upper_bound = None if hardness is None else hardness / self.pressure_scale
         self.max_height = float(-allmin(self.mpi, [-self.local(self.heights, readonly=True).max()])[0])
         self.progress = None
+        self.stop_requested = None
 
     # --- vectors and fields -------------------------------------------------
     def vec(self):

@@ -26,7 +26,7 @@ import os
 import platform
 import re
 
-from .errors import ParameterError
+from .errors import ParameterError, UserError
 
 EFFORTS = ("FFTW_ESTIMATE", "FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE")
 EFFORT_VARIABLE = "ROUGHPETSC_FFT_EFFORT"
@@ -77,6 +77,22 @@ def wisdom_path(option_value):
     if value.lower() == "none":
         return None
     return value or default_wisdom_path()
+
+
+def check_wisdom_path(option_value, option):
+    """Refuse, naming ``-option``, a wisdom file given in a folder that does not exist, or a folder.
+
+    The default cache's folder is created when it is first written; a path given by hand that cannot
+    be used would otherwise be skipped without a word, and every run would measure its plans again.
+    """
+    value = (option_value or "").strip()
+    if not value or value.lower() == "none":
+        return
+    if os.path.isdir(value):
+        raise UserError(f"-{option} {value}: is a folder; give a file name (or none)")
+    folder = os.path.dirname(os.path.abspath(value))
+    if not os.path.isdir(folder):
+        raise UserError(f"-{option} {value}: the folder {folder} does not exist")
 
 
 def _decode(text):

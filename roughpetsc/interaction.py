@@ -26,8 +26,12 @@ LAWS = ("none", "dugdale", "exponential")
 
 
 def _positive(name, value, what):
-    if not (value is not None and value > 0 and math.isfinite(value)):
-        raise ParameterError(name, f"the {what} must be positive and finite, got {value}")
+    """``value`` as a float; :class:`ParameterError` naming ``name`` if it is missing (None), or not positive and
+    finite (quoting it)."""
+    if value is None:
+        raise ParameterError(name, f"the {what} is missing: give a positive value")
+    if not (value > 0 and math.isfinite(value)):
+        raise ParameterError(name, f"the {what} must be positive and finite, got {value:g}")
     return float(value)
 
 
@@ -113,23 +117,31 @@ class Exponential:
         return self.energy_changes_from(gap)(trial, np.empty_like(trial))
 
     def energy_changes_from(self, gap, scratch=None):
-        """``change(trial, out)``: :meth:`energy_change` from ``gap`` written to ``out`` (which may be ``trial``),
-        phi(gap) made once (a line search calls it for every trial step); ``scratch``: two arrays of gap's
-        shape it keeps (allocated if None)."""
-        base, above = scratch if scratch is not None else (np.empty_like(gap), np.empty_like(gap))
-        np.multiply(gap, -1.0 / self.range, out=base)
-        np.exp(base, out=base)
-        base *= -self.work  # phi(gap)
+        """``change(trial, out)``: :meth:`energy_change` from ``gap`` written to ``out`` (which may be ``trial``);
+        ``scratch``: three arrays of gap's shape it keeps (allocated if None).
+
+        phi(t) - phi(g) = s phi(min(g, t)) expm1(-|g - t| / rho), s = 1 for t >= g and -1 below: one
+        expm1 that does not cancel for close gaps, and exponents that are never positive, so that no
+        range however short overflows (exp(-g / rho) may underflow to 0, which is phi's value then).
+        """
+        difference, smaller, factor = scratch if scratch is not None else (
+            np.empty_like(gap), np.empty_like(gap), np.empty_like(gap))
 
         def change(trial, out):  # out may be trial
-            np.maximum(trial, 0.0, out=above)
-            np.subtract(trial, above, out=out)  # the part of the trial below 0, on phi's tangent there
+            np.maximum(trial, 0.0, out=smaller)
+            np.subtract(trial, smaller, out=out)  # the part of the trial below 0, on phi's tangent there
             out *= self.peak_stress
-            np.subtract(gap, above, out=above)
-            np.multiply(above, 1.0 / self.range, out=above)
-            np.expm1(above, out=above)
-            np.multiply(above, base, out=above)
-            out += above
+            np.subtract(gap, smaller, out=difference)            # g - t
+            np.minimum(smaller, gap, out=smaller)
+            np.multiply(smaller, -1.0 / self.range, out=smaller)
+            np.exp(smaller, out=smaller)
+            np.multiply(smaller, -self.work, out=smaller)        # phi(min(g, t))
+            np.abs(difference, out=factor)
+            np.multiply(factor, -1.0 / self.range, out=factor)
+            np.expm1(factor, out=factor)                         # expm1(-|g - t| / rho)
+            np.copysign(factor, difference, out=factor)          # s expm1(...), as expm1 <= 0: the sign of g - t
+            np.multiply(factor, smaller, out=factor)
+            out += factor
             return out
 
         return change
@@ -159,8 +171,14 @@ def make_law(kind, work=None, stress=None, range_=None):
     if kind == "none":
         return None
     if kind == "dugdale":
-        if stress is None and range_ is not None:
-            stress = work / _positive("adhesion_range", range_, "range of adhesion") if work else None
+        if stress is not None and range_ is not None:
+            raise ParameterError("adhesion_range", "give the Dugdale stress or the range, not both (h0 = w / sigma0)")
+        if stress is None and range_ is None:
+            raise ParameterError("adhesion_stress", "the Dugdale law needs its stress sigma0 or its range h0 = w / "
+                                                    "sigma0: give one")
+        if range_ is not None:
+            stress = _positive("adhesion_work", work, "work of adhesion") / \
+                _positive("adhesion_range", range_, "range of adhesion")
         return Dugdale(work, stress)
     if kind == "exponential":
         return Exponential(work, range_)

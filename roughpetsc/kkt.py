@@ -64,7 +64,8 @@ def allmax(comm, values):
     return _allreduce(comm, values, "MAX")
 
 
-@PETSc.Log.EventDecorator("RPKKTCheck")  # -log_view: the residual check of every iteration
+# -log_view: every call (the certificate of each result; each iteration of the TAO types' convergence test)
+@PETSc.Log.EventDecorator("RPKKTCheck")
 def report(comm, pressure, gap, n_total, target_pbar=None, upper=None):
     """KKT report of local arrays ``pressure``, ``gap`` (scaled units, rms height 1).
 
@@ -131,6 +132,7 @@ class History:
         self.operator = problem.operator
         self.mpi = problem.mpi
         self.progress = problem.progress
+        self.stop_requested = problem.stop_requested
         self.start = time.perf_counter()
         self.rows = []
 
@@ -141,36 +143,64 @@ class History:
             self.progress(iteration, natural, seconds)
 
     def out_of_time(self, max_seconds):
-        """True when ``max_seconds`` (> 0) have passed since the history started (``-solve_max_time``).
+        """True when ``max_seconds`` (> 0) have passed since the history started (``-solve_max_time``), or
+        when a stop was requested on any rank (the problem's ``stop_requested``, Ctrl-C).
 
-        Collective when ``max_seconds > 0``: rank 0's clock decides for every rank, as ranks whose clocks
-        disagreed at the limit would leave the solve by different iterations and hang.
+        Collective when ``max_seconds > 0`` or a stop can be requested: rank 0's clock decides for
+        every rank, as ranks whose clocks disagreed at the limit would leave the solve by different
+        iterations and hang, and a request on any rank stops them all.
         """
-        if not max_seconds > 0:
+        timed = max_seconds > 0
+        if not timed and self.stop_requested is None:
             return False
-        return self.mpi.bcast(time.perf_counter() - self.start > max_seconds, root=0)
+        expired = timed and time.perf_counter() - self.start > max_seconds
+        asked = self.stop_requested is not None and self.stop_requested()
+        if self.mpi.Get_size() == 1:
+            return expired or asked
+        from mpi4py import MPI
+
+        return bool(self.mpi.allreduce(int((expired and self.mpi.Get_rank() == 0) or asked), op=MPI.MAX))
 
     def as_array(self):
         return np.array(self.rows, dtype=np.float64).reshape(-1, 4)
 
 
 class Progress:
-    """Prints ``iteration, natural residual, elapsed seconds`` of a running solve at most every ``interval`` s.
+    """Prints where a running load step is, at most every ``interval`` seconds of wall time.
 
-    Nothing is printed for a solve shorter than ``interval`` (the steps of a load path print their own lines).
+    A line names the load step (:meth:`start_step`), the inner solve of the step (a root find on the
+    separation solves several problems in a row, each counting its iterations from 0, and a solve
+    that is resumed to confirm its result is a second one), the iteration, the natural residual and
+    the seconds since the step began::
+
+          ... step 3 of 95 (pstar 0.02): inner solve 2, iteration 120, KKT natural 1.20e-05, 4.1 s
+
+    Nothing is printed for a step shorter than ``interval`` (each step prints its own line when it ends).
     """
 
     def __init__(self, interval, stream):
         self.interval = interval
         self.stream = stream
         self.printed_at = -np.inf
+        self.step = "the solve"
+        self.step_started = time.perf_counter()
+        self.inner = 0
+
+    def start_step(self, index, count, kind, value):
+        """A new load step: the ``index``-th (from 0) of ``count``, ``kind`` (pstar, pbar, gbar) = ``value``."""
+        self.step = f"step {index + 1} of {count} ({kind} {value:g})"
+        self.step_started = time.perf_counter()
+        self.inner = 0
 
     def __call__(self, iteration, natural, seconds):
+        if iteration == 0:  # every solve records its iteration 0 first
+            self.inner += 1
         now = time.perf_counter()
-        if seconds >= self.interval and now - self.printed_at >= self.interval:
+        elapsed = now - self.step_started
+        if elapsed >= self.interval and now - self.printed_at >= self.interval:
             self.printed_at = now
-            print(f"  ... iteration {iteration}, KKT natural {natural:.2e}, {seconds:.1f} s", file=self.stream,
-                  flush=True)
+            print(f"  ... {self.step}: inner solve {max(self.inner, 1)}, iteration {iteration}, KKT natural "
+                  f"{natural:.2e}, {elapsed:.1f} s", file=self.stream, flush=True)
 
 
 # A TAO solve whose natural residual has not improved on its best for this many

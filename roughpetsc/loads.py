@@ -41,21 +41,57 @@ def history():
     return np.where(i <= N1, early, np.where(i <= N1 + N2, medium, late))
 
 
+# A list option whose value starts with this reads its items from the file named after it (-pstar_list @loads.txt).
+LIST_FILE_PREFIX = "@"
+
+
+def parse_reals(text, name):
+    """The reals of a list option: comma-separated in the value, or, for ``@FILE``, in that file.
+
+    A file holds numbers separated by commas, blanks or line ends; ``#`` starts a comment. Every item
+    is used exactly as given: an empty item (``0.5,,1``), a word or an empty list is refused, naming
+    ``-name`` (and the file). Returns a list of floats.
+    """
+    text = (text or "").strip()
+    if text.startswith(LIST_FILE_PREFIX):
+        path = text[len(LIST_FILE_PREFIX):]
+        try:
+            with open(path) as handle:
+                lines = [line.split("#", 1)[0] for line in handle]
+        except (OSError, UnicodeDecodeError) as error:
+            reason = getattr(error, "strerror", None) or str(error)
+            raise UserError(f"-{name} {text}: cannot read the file {path} ({reason})") from None
+        items = " ".join(lines).replace(",", " ").split()
+        where = f" in the file {path}"
+        if not items:
+            raise UserError(f"-{name} {text}: the file {path} holds no numbers")
+    else:
+        if not text:
+            raise UserError(f"-{name}: the list is empty")
+        items = text.split(",")
+        where = f" in '{text}'" if len(text) <= 80 else f" in the list of {len(items)} items"
+        if not all(item.strip() for item in items):  # '0.5,,1' or a trailing comma: a value was left out
+            raise UserError(f"-{name}: empty item{where} (give comma-separated numbers, e.g. 0.1,0.5,1, or "
+                            f"{LIST_FILE_PREFIX}FILE)")
+    values = []
+    for position, item in enumerate(items, 1):
+        try:
+            values.append(float(item))
+        except ValueError:
+            raise UserError(f"-{name}: item {position} '{item.strip()}'{where} is not a number") from None
+    return values
+
+
 def parse(text, option):
-    """Loads from an option value: ``history`` (7.11) or a comma-separated list of positive p*.
+    """Loads from an option value: ``history`` (7.11), or a list of positive p* (:func:`parse_reals`).
 
     Raises :class:`UserError` naming ``-option`` on anything else.
     """
     text = (text or "").strip()
     if text.lower() == "history":
         return history()
-    try:
-        values = np.array([float(item) for item in text.split(",") if item.strip()])
-    except ValueError:
-        raise UserError(f"-{option}: expected 'history' or comma-separated positive p* values, got '{text}'") \
-            from None
-    if values.size == 0:
-        raise UserError(f"-{option}: the list of loads is empty")
+    values = np.array(parse_reals(text, option))
     if not np.all(np.isfinite(values) & (values > 0)):
-        raise UserError(f"-{option}: every p* must be positive and finite, got '{text}'")
+        bad = values[~(np.isfinite(values) & (values > 0))][0]
+        raise UserError(f"-{option}: every p* must be positive and finite, got {bad:g}")
     return values

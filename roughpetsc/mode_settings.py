@@ -35,7 +35,7 @@ PARAMETER_OPTIONS = {**{keyword: option for option, keyword in surfaces.FRACTAL_
                      "n1": "surface_N", "n0": "surface_N0/-surface_N", "length": "surface_L",
                      "kind": "surface_type", "heights": "surface_type", "path": "surface_file",
                      "amplitude": "surface_amplitude", "wavelength": "surface_wavelength", "radius": "surface_radius",
-                     "effort": "fft_effort", "E_star": "E_star", "e_star": "E_star", "rtol": "kkt_rtol",
+                     "effort": "fft_effort", "detrend": "surface_detrend", "E_star": "E_star", "e_star": "E_star", "rtol": "kkt_rtol",
                      "tao_type": "tao_type", "pstar": "pstar", "pbar": "pbar", "gbar": "gbar",
                      "boundary": "boundary", "hardness": "hardness", "depths": "stress_depths", "nu": "nu",
                      **{name: name for name in ("adhesion", "adhesion_work", "adhesion_stress", "adhesion_range")}}

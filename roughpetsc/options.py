@@ -6,11 +6,13 @@ import difflib
 import functools
 import glob
 import os
+import re
 import warnings
 
 from petsc4py import PETSc
 
 from .errors import UserError
+from .loads import LIST_FILE_PREFIX, parse_reals
 
 # Prefixes of options that PETSc objects or PETSc itself read.
 PETSC_PREFIXES = ("tao_", "ksp_", "pc_", "mat_", "vec_", "snes_", "log", "options_", "malloc", "info", "help",
@@ -19,8 +21,15 @@ PETSC_PREFIXES = ("tao_", "ksp_", "pc_", "mat_", "vec_", "snes_", "log", "option
                   "history", "use_gpu", "device_", "petsc")
 
 
+# petsc4py 3.18 reads a string option into a buffer of this many bytes: longer values come back cut.
+PETSC4PY_STRING_BUFFER = 1024
+
+
 class Reader:
-    """Typed reads from the options database that name the option on bad values."""
+    """Typed reads from the options database that name the option on bad values.
+
+    Strings are read whole, whatever their length (:meth:`string`); lists are read by :meth:`reals`.
+    """
 
     def __init__(self, database=None):
         self.database = database or PETSc.Options()
@@ -38,7 +47,9 @@ class Reader:
         return self._get(self.database.getInt, name, default)
 
     def string(self, name, default):
-        return self._get(self.database.getString, name, default)
+        """The value of ``-name`` as given (any length), or ``default`` if the option is absent."""
+        text = self._get(self.database.getString, name, default)
+        return whole_string(name, text, self.database.prefix) if self.database.hasName(name) else text
 
     def bool(self, name, default):
         return self._get(self.database.getBool, name, default)
@@ -47,19 +58,10 @@ class Reader:
         return self.database.hasName(name)
 
     def reals(self, name):
-        """A comma-separated list of reals, or None if the option is absent."""
+        """The list of reals of ``-name`` (:func:`parse_reals`), or None if the option is absent."""
         if not self.database.hasName(name):
             return None
-        text = self.database.getString(name, "")
-        if not text.strip():
-            raise UserError(f"-{name}: the list is empty")
-        items = text.split(",")
-        if not all(item.strip() for item in items):  # '0.5,,1' or a trailing comma: a value was left out
-            raise UserError(f"-{name}: empty item in '{text}' (give comma-separated numbers, e.g. 0.1,0.5,1)")
-        try:
-            return [float(item) for item in items]
-        except ValueError:
-            raise UserError(f"-{name}: expected comma-separated numbers, got '{text}'") from None
+        return parse_reals(self.string(name, ""), name)
 
     # petsc4py.PETSc.Options-like interface for modules that expect it
     getReal = real
@@ -69,6 +71,32 @@ class Reader:
 
     def hasName(self, name):
         return self.has(name)
+
+
+def whole_string(name, text, prefix=None):
+    """``text``, the value of ``-name`` (options prefix ``prefix``) as petsc4py read it, completed if cut.
+
+    petsc4py 3.18 reads at most 1023 characters (:data:`PETSC4PY_STRING_BUFFER`); a value of that length
+    is read again through ``PetscOptionsGetString`` with a buffer as long as it needs. Where the PETSc
+    library cannot be called, a value that may have been cut is refused rather than used cut.
+    """
+    if text is None or len(text.encode()) < PETSC4PY_STRING_BUFFER - 1:
+        return text
+    library, why = petsc_library()
+    if library is None:
+        raise UserError(f"-{name}: a value of {PETSC4PY_STRING_BUFFER - 1} characters or more cannot be read "
+                        f"whole here ({why}); give a list in a file, -{name} {LIST_FILE_PREFIX}FILE")
+    size = 4 * PETSC4PY_STRING_BUFFER
+    while True:
+        buffer = ctypes.create_string_buffer(size)
+        found = ctypes.c_int(0)  # PetscBool
+        if library.PetscOptionsGetString(None, prefix.encode() if prefix else None, ("-" + name).encode(), buffer,
+                                         ctypes.c_size_t(size), ctypes.byref(found)):
+            raise UserError(f"-{name}: PETSc could not read the value")
+        value = buffer.value.decode()
+        if len(buffer.value) < size - 1:
+            return value
+        size *= 4
 
 
 # TAO options renamed in PETSc 3.21, and their names in older releases: a command written for a current
@@ -120,6 +148,25 @@ def check_names(known_names):
         guess = difflib.get_close_matches(name, known_names, n=1)
         hint = f" (did you mean -{guess[0]}?)" if guess else ""
         raise UserError(f"unknown option -{name}{hint}; -help lists the options")
+
+
+def check_values_given(defaults):
+    """Refuse an option of ours given without a value, naming it.
+
+    ``defaults`` maps each of our option names to its default, whose type is the option's. PETSc keeps
+    an option given without a value (``-gbar`` alone, ``-output -json x``, ``-surface_file ""``, a bare
+    line in an options file) as set with no value, and its getters then return the caller's default: a
+    silent default in place of the value meant. Only a switch (a bool option) stands alone.
+    """
+    bare = [name for name, value in PETSc.Options().getAll().items()
+            if name in defaults and value is None and not isinstance(defaults[name], bool)]
+    if len(bare) == 1:
+        name = bare[0]
+        example = defaults[name] if defaults[name] != "" else "VALUE"
+        raise UserError(f"-{name} was given without a value; give one (-{name} {example}) or leave the option out")
+    if bare:
+        raise UserError(f"{', '.join('-' + name for name in bare)} were given without a value; give each one "
+                        "or leave them out")
 
 
 def _library_candidates():
@@ -207,16 +254,33 @@ def read_late(name):
     return "view" in name or "converged_reason" in name
 
 
-def check_unused(ignore=(), final=True):
+# Options of the parts of a TAO that a solver never runs (its line search, its KSP and PC, another TAO type's):
+# PETSc reads them into the objects every TAO creates, so they count as used although nothing uses them.
+PARTS_UNUSED_BY_PYTHON_TAO = re.compile(
+    r"^(tao_ls_|tao_ksp_|tao_pc_|ksp_|pc_|tao_(bnk|bqnk|bncg|bqnls|blmvm|lmvm|almm|gpcg|tron|bnls|bntr|bntl|nls|ntr|"
+    r"ntl|owlqn|bmrm|pounders|brgn|admm|ipm|pdipm|cg|nm|lcl)_|tao_subset_type)")
+
+
+def given_but_unusable(pattern, prefix=None):
+    """The options given (with ``prefix``) whose names match ``pattern`` after the prefix: read, never used."""
+    prefix = prefix or ""
+    return [name for name in PETSc.Options().getAll()
+            if name.startswith(prefix) and pattern.match(name[len(prefix):])]
+
+
+def check_unused(ignore=(), final=True, unusable=()):
     """Raise :class:`UserError` if an option was given that nothing used (a misspelling, say).
 
     With ``final=False`` (before a solve) options that PETSc reads only during
     or after the solve (:func:`read_late`) are skipped, so a misspelling fails
     before the work and a late option is checked by the final call after it.
+    ``unusable`` names options that were read but that the run cannot use (the line search or KSP of a
+    solver that has none, :func:`given_but_unusable`): reported like the unused ones.
     """
     unused = unused_options()
     if unused is None:  # cannot be checked here: unused_options has said so
         return
+    unused = list(unused) + [name for name in unusable if name not in unused]
     left = [name for name in unused
             if name not in ignore and name not in FINALIZE_OPTIONS and (final or not read_late(name))]
     if left:

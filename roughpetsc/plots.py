@@ -1,4 +1,5 @@
-"""Figures of a solve (``-plot PATH.png``): pressure and gap maps of the last step, A* against p* of a load path.
+"""Figures of a solve (``-plot PATH.png``): pressure and gap maps of the last step, A* against p* of a load path,
+the mean pressure against the mean gap of an adhesive path (its approach and retraction).
 
 Drawn with matplotlib's Agg canvas through :class:`matplotlib.figure.Figure`
 (no pyplot, no display, no global backend state); the format follows the
@@ -8,7 +9,7 @@ file's suffix.
 import os
 
 
-def plot_solution(path, grid, pressure, gap, steps):
+def plot_solution(path, grid, pressure, gap, steps, adhesion=None):
     """Write the figure of a solve to ``path`` (atomically).
 
     Parameters
@@ -20,8 +21,12 @@ def plot_solution(path, grid, pressure, gap, steps):
     pressure, gap : ndarray (n0, n1)
         Fields of the last step, pressure and length units.
     steps : list of dict
-        Step summaries (``pstar``, ``A``, ``A_corrected``); with more than one,
-        a third panel shows the contact area against the load.
+        Step summaries (``pstar``, ``A``, ``A_corrected``, ``pbar``, ``gbar``); with more than one,
+        a third panel shows the contact area against the load, or, for an adhesive path, the mean
+        pressure against the mean gap.
+    adhesion : dict or None
+        The run's adhesion summary (``law``, ``dissipated_energy`` of a closed cycle) for an adhesive
+        path, else None.
     """
     from matplotlib.figure import Figure
     import numpy as np
@@ -40,7 +45,9 @@ def plot_solution(path, grid, pressure, gap, steps):
         image = ax.imshow(field, extent=extent, cmap=colours, interpolation="nearest")
         ax.set(xlabel="x", ylabel="y", title=title)
         figure.colorbar(image, ax=ax, label=label, shrink=0.85)
-    if panels == 3:
+    if panels == 3 and adhesion is not None:
+        draw_cycle(axes[2], steps, adhesion)
+    elif panels == 3:
         ax = axes[2]
         pstar = [s["pstar"] for s in steps]
         ax.plot(pstar, [s["A"] for s in steps], "o-", markersize=3, label="A* (node count)")
@@ -51,3 +58,23 @@ def plot_solution(path, grid, pressure, gap, steps):
     suffix = os.path.splitext(path)[1].lower().lstrip(".")
     with io.atomic_path(path) as temporary:
         figure.savefig(temporary, format=suffix, dpi=110)
+
+
+def draw_cycle(ax, steps, adhesion):
+    """pbar against the mean gap of an adhesive path, in step order: approach (gap closing) and retraction."""
+    gaps = [s["gbar"] for s in steps]
+    pbars = [s["pbar"] for s in steps]
+    for k in range(1, len(steps)):
+        closing = gaps[k] < gaps[k - 1]
+        ax.plot(gaps[k - 1:k + 1], pbars[k - 1:k + 1], "-", color="tab:blue" if closing else "tab:red",
+                label=("approach" if closing else "retraction"))
+    ax.plot(gaps, pbars, "k.", markersize=4)
+    handles, labels = ax.get_legend_handles_labels()
+    unique = dict(zip(labels, handles))
+    ax.legend(unique.values(), unique.keys())
+    ax.axhline(0.0, color="0.5", linewidth=0.8)
+    energy = adhesion.get("dissipated_energy")
+    title = f"{adhesion['law']} adhesion" + (f"\ndissipated {energy:.3g} per unit area" if energy is not None else "")
+    ax.set(xlabel="mean gap gbar", ylabel="mean pressure pbar (tension < 0)")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)

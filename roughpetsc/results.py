@@ -51,6 +51,7 @@ class PathRecord:
         self.stresses = []  # roughpetsc.stresses.DepthStresses of the last step (-stress_depths)
         self.write_seconds = 0.0
         self.written_at = -np.inf
+        self.written = 0  # steps in the files as last written (those taken from a resumed file included)
 
     def add(self, step, history, pressure=None, gap=None):
         """Record a finished step: its summary, residual history and (whole) fields, pressure and length units."""
@@ -83,6 +84,7 @@ class PathRecord:
                             first_row=self.first_row if distributed else None)
         if json_path and rank0:
             io.write_json(json_path, self.as_summary())
+        self.written = len(self.steps)
         self.written_at = time.perf_counter()
         self.write_seconds = self.written_at - start
 
@@ -94,18 +96,18 @@ class PathRecord:
         """
         return time.perf_counter() - self.written_at >= 4.0 * self.write_seconds
 
-    def resume_from(self, path, loads):
-        """Take from ``path`` the leading steps of ``loads`` it solved for the same problem.
+    def resume_from(self, path, loads, load_option):
+        """Take from ``path`` the steps of ``loads`` it solved for the same problem.
 
-        ``loads`` is the list of ``(option, value)`` of this run. A step is
-        taken if it converged and its load equals the load of this run at the
-        same position; the first other step and all after it are solved again.
-        Returns the whole pressure field (pressure units) to start the next
-        load from (that of the last step taken, else the last one saved), or
-        None.
+        ``loads`` is the list of ``(kind, value)`` of this run, given by ``-load_option``. The loads
+        saved in the file must be the first loads of this run (a longer list extends the path):
+        otherwise resuming would lose saved steps, and the run is refused, naming them. The
+        converged steps are taken up to the first that did not converge, which is solved again with
+        all after it. Returns the whole pressure field (pressure units) to start the next load from
+        (that of the last step taken, else the last one saved), or None.
 
-        Raises :class:`UserError` if the file records another problem
-        (surface, grid, E*, solver, control or tolerance).
+        Raises :class:`UserError` if the file records another problem (surface, grid, E*, solver,
+        control or tolerance) or other loads.
         """
         try:
             stored = load_path.read(path)
@@ -119,12 +121,13 @@ class PathRecord:
         if differ:
             raise UserError(f"-resume: {path} was made for another problem (different {', '.join(differ)}); "
                             "give another -output, or the options that made it")
+        saved = [(step["summary"].get("load_option"), step["summary"].get("load_value")) for step in stored["steps"]]
+        check_continuation(path, saved, loads, load_option)
         start = stored["last_fields"].get("pressure")
         rows = slice(None) if self.first_row is None else slice(self.first_row, self.first_row + self.local_rows)
-        for (option, value), step in zip(loads, stored["steps"]):
+        for step in stored["steps"]:
             summary = step["summary"]
-            if not (summary.get("converged") and summary.get("load_option") == option
-                    and summary.get("load_value") == value):
+            if not summary.get("converged"):
                 break
             fields = [step["fields"][name][rows] if name in step["fields"] else None for name in ("pressure", "gap")]
             self.add(summary, step["history"], *fields)
@@ -134,4 +137,33 @@ class PathRecord:
                 and "pressure" in stored["last_fields"]:
             # Every step taken: the last fields of the file are those of the last step taken.
             self.last_fields = {name: array[rows] for name, array in stored["last_fields"].items()}
+        self.written = len(self.steps)
         return start
+
+
+def describe_loads(loads):
+    """A few of the loads ``(kind, value)`` of a path, exactly as stored: ``pstar 0.1, 0.2, ..., 4 (95 loads)``."""
+    values = [repr(float(value)) for _, value in loads]
+    shown = values if len(values) <= 6 else values[:3] + ["..."] + values[-2:]
+    kinds = sorted({str(kind) for kind, _ in loads})
+    return f"{'/'.join(kinds)} {', '.join(shown)} ({len(values)} load{'s' if len(values) != 1 else ''})"
+
+
+def check_continuation(path, saved, loads, load_option):
+    """Refuse a resumed run whose loads do not begin with the ``saved`` ones: it would drop saved steps.
+
+    ``saved`` and ``loads`` are lists of ``(kind, value)``; ``load_option`` names the option of ``loads``.
+    """
+    loads = [(kind, float(value)) for kind, value in loads]
+    saved = [(kind, float(value)) for kind, value in saved]
+    if loads[:len(saved)] == saved:
+        return
+    if len(loads) < len(saved) and saved[:len(loads)] == loads:
+        why = f"this run's -{load_option} stops after {len(loads)} of them"
+    else:
+        at = next(i for i, (ours, theirs) in enumerate(zip(loads, saved)) if ours != theirs)
+        why = (f"this run's -{load_option} differs at step {at + 1}: {loads[at][0]} {loads[at][1]!r} here, "
+               f"{saved[at][0]} {saved[at][1]!r} in the file")
+    raise UserError(f"-resume: {path} holds {len(saved)} saved step(s), {describe_loads(saved)}, and {why}; "
+                    "resuming would lose saved steps. Give loads that begin with the saved ones (a longer list "
+                    "extends the path), or another -output")

@@ -8,7 +8,6 @@ This module imports PETSc only when it runs (``-help`` prints its table before P
 
 from dataclasses import dataclass, fields
 import os
-import signal
 import sys
 
 import numpy as np
@@ -29,8 +28,10 @@ SETTINGS_OPTIONS = [
                       "loads are kept, the rest solved from the last saved pressure"),
     ("plot", "", "write a figure to PATH (.png, .pdf, .svg, ...): pressure and gap maps of the last step, A* "
                  "against p* of a load path"),
-    ("progress_interval", 3.0, "on a terminal, print iteration, KKT residual and elapsed time of a running solve "
-                               "every this many seconds (0: never; never when stdout is not a terminal)"),
+    ("progress", "auto", "progress lines of a running load step (its step, inner solve, iteration, KKT residual, "
+                         "seconds): auto (only when a person watches: rank 0's output is a terminal, not a pipe or "
+                         "a file, also under mpiexec) | on | off"),
+    ("progress_interval", 3.0, "seconds between progress lines (> 0)"),
     ("fft_threads", 1, "FFTW threads on one rank"),
     ("fft_effort", "FFTW_MEASURE", "FFTW planner effort: FFTW_ESTIMATE | FFTW_MEASURE | FFTW_PATIENT "
                                    "(measured plans are remembered, see -fft_wisdom)"),
@@ -51,15 +52,24 @@ PHYSICS_OPTIONS = [
     ("nu", 0.3, "Poisson's ratio of the body, for -stress_depths"),
 ] + adhesive_options.OPTIONS
 
+PROGRESS_CHOICES = ("auto", "on", "off")
+
 LOAD_OPTIONS = [
     ("pstar", 0.5, "load control: p* = pbar / sqrt(m0^p) (the default load)"),
     ("pbar", "", "load control: mean pressure pbar, pressure units"),
     ("gbar", "", "displacement control: prescribed mean gap (rigid separation) d, length units"),
-    ("pstar_list", "", "load control: comma-separated p* values solved in order with warm starts, or 'history' "
-                       "(the 95 steps of (7.11), D1 = 0.2/30)"),
-    ("gbar_list", "", "displacement control: comma-separated mean gaps solved in order with warm starts (an "
-                      "approach and retraction with -adhesion)"),
+    ("pstar_list", "", "load control: p* values solved in order with warm starts: comma-separated, @FILE (numbers "
+                       "separated by commas, blanks or lines; # comments), or 'history' (the 95 steps of (7.11), "
+                       "D1 = 0.2/30)"),
+    ("pbar_list", "", "load control: mean pressures pbar (pressure units) solved in order with warm starts: "
+                      "comma-separated or @FILE"),
+    ("gbar_list", "", "displacement control: mean gaps (length units) solved in order with warm starts: "
+                      "comma-separated or @FILE (an approach and retraction with -adhesion)"),
 ]
+
+# Each load option: the load it sets (a keyword of Solver.solve); the *_list options give several.
+LOAD_KINDS = {"pstar": "pstar", "pbar": "pbar", "gbar": "gbar", "pstar_list": "pstar", "pbar_list": "pbar",
+              "gbar_list": "gbar"}
 
 # Read by the solvers from the options database (roughpetsc.solvers).
 SOLVER_OPTIONS = [
@@ -102,6 +112,7 @@ class SolveSettings:
     output_fields: str
     resume: bool
     plot: str
+    progress: str
     progress_interval: float
     fft_threads: int
     fft_effort: str
@@ -127,23 +138,20 @@ class SolveSettings:
 
 
 def load_steps(reader):
-    """The list of loads: ``("pstar" | "pbar" | "gbar", value)`` in the order to solve."""
-    given = [name for name in ("pstar", "pbar", "gbar", "pstar_list", "gbar_list") if reader.has(name)]
+    """The list of loads: ``("pstar" | "pbar" | "gbar", value)`` in the order to solve, and the option."""
+    given = [name for name in LOAD_KINDS if reader.has(name)]
     if len(given) > 1:
-        raise UserError("give only one of -pstar, -pbar, -gbar, -pstar_list, -gbar_list; got "
+        raise UserError(f"give only one of {', '.join('-' + name for name in LOAD_KINDS)}; got "
                         + ", ".join("-" + g for g in given))
-    if given == ["gbar_list"]:
-        return [("gbar", v) for v in reader.reals("gbar_list")], "gbar_list"
-    if given == ["pstar_list"]:
-        if reader.string("pstar_list", "").strip().lower() == "history":
-            from . import loads
-
-            return [("pstar", float(v)) for v in loads.history()], "pstar_list"
-        values = reader.reals("pstar_list")
-        return [("pstar", v) for v in values], "pstar_list"
     name = given[0] if given else "pstar"
-    value = reader.real(name, 0.5)
-    return [(name, value)], name
+    kind = LOAD_KINDS[name]
+    if name == "pstar_list" and reader.string(name, "").strip().lower() == "history":
+        from . import loads
+
+        return [(kind, float(v)) for v in loads.history()], name
+    if name.endswith("_list"):
+        return [(kind, v) for v in reader.reals(name)], name
+    return [(kind, reader.real(name, 0.5))], name
 
 
 def read_settings(reader, general_options=GENERAL_OPTIONS):
@@ -169,6 +177,11 @@ def read_settings(reader, general_options=GENERAL_OPTIONS):
     if settings.resume and not settings.output:
         raise UserError("-resume needs -output: the file of the run to continue")
     check_fft(settings.fft_threads, settings.fft_effort)
+    if settings.progress not in PROGRESS_CHOICES:
+        raise UserError(f"-progress: unknown value '{settings.progress}' (one of {', '.join(PROGRESS_CHOICES)})")
+    if not (settings.progress_interval > 0 and np.isfinite(settings.progress_interval)):
+        raise UserError(f"-progress_interval must be a positive number of seconds, got {settings.progress_interval} "
+                        "(-progress off turns the lines off)")
     if settings.adhesion is not None:
         adhesive_options.check(settings)
     return settings
@@ -191,19 +204,45 @@ def read_physics(reader):
             check_depths(depths)
         check_poisson(values["nu"])
     return {"boundary": values["boundary"], "hardness": hardness or None, "stress_depths": depths,
-            "nu": values["nu"], "adhesion": adhesive_options.read_law(values)}
+            "nu": values["nu"],
+            "adhesion": adhesive_options.read_law(values, {name for name in values if reader.has(name)})}
 
 
 def check_files(settings, comm):
-    """Refuse, on every rank, outputs that exist (without -overwrite), overwrite the input or cannot be written."""
-    from . import io
+    """Refuse, on every rank, outputs that exist (without -overwrite), overwrite the input or cannot be written.
 
-    # Checked on rank 0, refused on every rank; the file of -output is meant to exist with -resume.
+    Under ``-resume`` the file of -output is meant to exist, and so is a -json summary that this load
+    path wrote (:func:`is_summary_of`): a resumed run rewrites both.
+    """
+    from . import fftw, io
+
+    def check():
+        may_exist = ("output",) if settings.resume else ()
+        if settings.resume and is_summary_of(settings.json, settings.output):
+            may_exist += ("json",)
+        io.check_outputs(outputs, settings.overwrite, [("surface_file", settings.surface_file)], may_exist)
+        fftw.check_wisdom_path(settings.fft_wisdom, "fft_wisdom")
+
     outputs = [("json", settings.json), ("output", settings.output), ("plot", settings.plot)]
-    io.on_root(comm, io.check_outputs, outputs, settings.overwrite, [("surface_file", settings.surface_file)],
-               ("output",) if settings.resume else ())
+    io.on_root(comm, check)  # checked on rank 0, refused on every rank
     if settings.plot:
         io.check_figure_format(settings.plot, "plot")
+
+
+def is_summary_of(json_path, h5_path):
+    """True if ``json_path`` is a solve-mode summary written by a run whose -output was ``h5_path``."""
+    import json
+
+    if not (json_path and h5_path and os.path.isfile(json_path)):
+        return False
+    try:
+        with open(json_path) as handle:
+            document = json.load(handle)
+        recorded = document["options"]["output"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+    return isinstance(document.get("steps"), list) and isinstance(recorded, str) and \
+        os.path.realpath(recorded) == os.path.realpath(h5_path)
 
 
 def printer(quiet, comm):
@@ -214,39 +253,104 @@ def printer(quiet, comm):
     return say
 
 
-def run(reader, comm):
-    """Solve the loads of the options on the surface of the options; the exit status (0, 3 or 130)."""
-    from petsc4py import PETSc
+class StepLines:
+    """The lines of finished steps, printed once the output files hold their step.
 
-    from . import fftw, io, store, surfaces
-    from .contact import ContactProblem
+    With ``-output`` or ``-json`` a step's line waits for the checkpoint that writes the step
+    (:func:`checkpoint`): a run interrupted at any moment has written every step it has printed.
+    Without output files a line is printed at once.
+    """
+
+    def __init__(self, say, hold):
+        self.say = say
+        self.hold = hold
+        self.pending = []
+
+    def add(self, text):
+        if self.hold:
+            self.pending.append(text)
+        else:
+            self.say(text)
+
+    def flush(self):
+        """Print the lines held so far (their steps are now in the files)."""
+        for text in self.pending:
+            self.say(text)
+        self.pending = []
+
+
+def progress_printer(settings, comm):
+    """The progress lines of a running step (:class:`roughpetsc.kkt.Progress`) on rank 0, or None.
+
+    ``-progress on`` or ``off`` decides; ``auto`` prints them when a person watches rank 0's output
+    (:func:`roughpetsc.terminal.watched`: a terminal, also behind mpiexec, never a pipe or a file).
+    """
     from .kkt import Progress
-    from .options import check_unused
-    from .results import PathRecord
-    from .slab import row_split
-    from .surface_moments import surface_moments
+    from .terminal import watched
+
+    if comm.Get_rank() != 0 or settings.quiet or settings.progress == "off":
+        return None
+    if settings.progress == "auto" and not watched(sys.stdout):
+        return None
+    return Progress(settings.progress_interval, sys.stdout)
+
+
+def run(reader, comm):
+    """Solve the loads of the options on the surface of the options; the exit status (0, 3 or 130).
+
+    From the first check on, Ctrl-C and SIGTERM ask the run to stop (:mod:`roughpetsc.interrupts`):
+    every rank leaves the solve at the same iteration, the files keep every step whose line was
+    printed, and one line says so (exit status 130).
+    """
+    from .interrupts import StopRequests
 
     settings = read_settings(reader)
-    say = printer(settings.quiet, comm)
     check_files(settings, comm)
+    with StopRequests() as requests:
+        return solve_settings(settings, reader, comm, requests)
+
+
+def build_problem(settings, reader, comm):
+    """``(grid, heights, problem, levelling)`` of the options: the surface, then the ContactProblem on every rank.
+
+    ``levelling``: the :class:`roughpetsc.surfaces.Levelling` of a surface file, None for a generated surface.
+    """
+    from petsc4py import PETSc
+
+    from . import fftw, surfaces
+    from .contact import ContactProblem
+    from .slab import row_split
+
     effort = fftw.planner_effort(settings.fft_effort)
     wisdom = fftw.wisdom_path(settings.fft_wisdom)
     if not settings.surface_file:
         # Before the surface is built: a grid with fewer rows than ranks is refused by name.
         row_split(surfaces.grid_from_options(reader).n0, comm.Get_size())
-    grid, heights = surfaces.from_options(reader)
+    levelling = []
+    grid, heights = surfaces.from_options(reader, notes=levelling)
     with fftw.remembered_plans(comm, wisdom, effort), options_named():
         problem = ContactProblem(grid, heights, settings.E_star, PETSc.COMM_WORLD, settings.fft_threads, effort,
                                  boundary=settings.boundary, hardness=settings.hardness)
-    statistics = surface_moments(grid, heights, settings.E_star)
-    solver = make_solver(settings, problem)
-    rank0 = comm.Get_rank() == 0
-    if settings.progress_interval > 0 and rank0 and not settings.quiet and sys.stdout.isatty():
-        problem.progress = Progress(settings.progress_interval, sys.stdout)
-    # A batch system's time limit (SIGTERM) ends the run like Ctrl-C: the finished steps are kept.
-    previous_sigterm = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    return grid, heights, problem, (levelling[0] if levelling else None)
+
+
+def solve_settings(settings, reader, comm, requests):
+    """:func:`run` once the settings and files are checked; ``requests`` the :class:`StopRequests` of the run."""
+    from . import io, store, surfaces
+    from .options import check_unused
+    from .results import PathRecord
+    from .surface_moments import surface_moments
+
+    say = printer(settings.quiet, comm)
+    grid, heights, problem, levelling = build_problem(settings, reader, comm)
+    solver = None
     try:
-        check_unused(final=False)  # misspellings fail now; options PETSc reads after a solve are checked then
+        problem.stop_requested = requests.is_set
+        problem.progress = progress_printer(settings, comm)
+        statistics = surface_moments(grid, heights, settings.E_star)
+        solver = make_solver(settings, problem)
+        unusable = getattr(solver, "unusable_options", list)()
+        check_unused(final=False, unusable=unusable)  # misspellings fail now; those read after a solve, then
         summary = {"grid": [grid.n0, grid.n1], "length": [grid.l0, grid.l1], "E_star": settings.E_star,
                    "surface": statistics, "surface_parameters": dict(surfaces.parameters(reader), surface_L=grid.l1),
                    "sqrt_m0h": problem.sqrt_m0h, "sqrt_m0p": problem.sqrt_m0p,
@@ -254,51 +358,79 @@ def run(reader, comm):
                    "boundary": settings.boundary, "hardness": settings.hardness or 0.0,
                    "adhesion": adhesive_options.summary(settings.adhesion, statistics, settings.E_star),
                    "ranks": comm.Get_size(), **io.provenance()}
+        if levelling is not None:
+            summary["surface_levelling"] = levelling.record()
         # Fields written by every rank into its rows where h5py is the parallel build (store.write_distributed).
         distributed = bool(settings.output) and settings.output_fields != "none" and store.parallel_hdf5(comm)
         rows = problem.local_rows
         record = PathRecord(summary, heights, settings.output_fields,
                             *((rows.start, rows.stop - rows.start) if distributed else ()))
-        h5_path = settings.output
-        if settings.resume and os.path.exists(h5_path):
-            start = record.resume_from(h5_path, list(settings.steps))
+        if settings.resume and os.path.exists(settings.output):
+            start = record.resume_from(settings.output, list(settings.steps), settings.load_option)
             if start is not None:  # the next solve scales it to its load (Solver's warm start)
                 problem.local(solver.pressure)[...] = start[problem.local_rows] / problem.pressure_scale
-        cap = f", hardness {settings.hardness:g}" if settings.hardness else ""
-        say(f"roughpetsc: {grid.n0}x{grid.n1} grid ({settings.boundary}{cap}) on {comm.Get_size()} rank(s), "
-            f"solver {solver.name}, E*={settings.E_star:g}, sqrt(m0h)={problem.sqrt_m0h:.4g}, "
-            f"sqrt(m0p)={problem.sqrt_m0p:.4g}, alpha_h={statistics['alpha_h']:.4g}, "
-            f"alpha_p={statistics['alpha_p']:.4g}")
-        if settings.adhesion is not None:
-            say(adhesive_options.header(settings.adhesion, summary["adhesion"]))
-        say(f"{'p*':>10} {'A*':>10} {'A*corr':>10} {'g*':>11} {'KKT nat':>9} {'its':>6} {'Kapps':>6} "
-            f"{'time s':>8}  reason")
+        say_header(settings, grid, problem, solver, statistics, summary, say)
+        if levelling is not None:
+            report_levelling(levelling, settings.surface_file, say, comm)
         for step in record.steps:
-            say(step_line(step) + f"  (from {h5_path})")
-        try:
-            solve_path(settings, solver, record, comm, say)
-        except KeyboardInterrupt:
-            if rank0 and record.steps:
-                # Rank 0 alone (the others may be anywhere): distributed fields cannot be written now.
-                record.write(h5_path, settings.json, with_fields=not distributed)
-            if rank0:
-                kept = f"; {h5_path} keeps them (rerun with -resume to continue)" if h5_path and record.steps else ""
-                print(f"roughpetsc: interrupted after {len(record.steps)} of {len(settings.steps)} step(s){kept}",
-                      file=sys.stderr, flush=True)
+            say(step_line(step) + f"  (from {settings.output})")
+        lines = StepLines(say, hold=bool(settings.output or settings.json))
+        if solve_path(settings, solver, record, comm, lines, requests, problem.progress):
+            io.on_root(comm, report_interruption, settings, record)
             return 130
         if settings.adhesion is not None:
-            adhesive_options.close_cycle(record, say)
+            adhesive_options.close_cycle(record, lines.add)
         whole = whole_last_fields(record, comm, distributed, settings)
         if settings.stress_depths:
-            io.on_root(comm, record_stresses, settings, record, grid, whole)
+            for text in io.on_root(comm, record_stresses, settings, record, grid, whole) or ():
+                lines.add(text)
         if distributed:
             record.write(settings.output, comm=comm)
         io.on_root(comm, write_outputs, settings, record, grid, whole, not distributed)
+        lines.flush()
         return 0 if all(step["converged"] for step in record.steps) else 3
     finally:
-        signal.signal(signal.SIGTERM, previous_sigterm)
-        solver.destroy()
+        if solver is not None:
+            solver.destroy()
         problem.destroy()
+
+
+def say_header(settings, grid, problem, solver, statistics, summary, say):
+    """The header of the step table: the problem, the solver, the surface's bandwidths, the column names."""
+    cap = f", hardness {settings.hardness:g}" if settings.hardness else ""
+    say(f"roughpetsc: {grid.n0}x{grid.n1} grid ({settings.boundary}{cap}) on {problem.mpi.Get_size()} rank(s), "
+        f"solver {solver.name}, E*={settings.E_star:g}, sqrt(m0h)={problem.sqrt_m0h:.4g}, "
+        f"sqrt(m0p)={problem.sqrt_m0p:.4g}, alpha_h={statistics['alpha_h']:.4g}, "
+        f"alpha_p={statistics['alpha_p']:.4g}")
+    if settings.adhesion is not None:
+        say(adhesive_options.header(settings.adhesion, summary["adhesion"]))
+    say(f"{'p*':>10} {'A*':>10} {'A*corr':>10} {'g*':>11} {'KKT nat':>9} {'its':>6} {'Kapps':>6} "
+        f"{'time s':>8}  reason")
+
+
+def report_levelling(levelling, path, say, comm):
+    """Rank 0: what levelling a surface file did (stdout) and its warnings (stderr), one line each."""
+    for note in levelling.notes:
+        if note.startswith("warning: ") and comm.Get_rank() == 0:
+            print(f"roughpetsc: warning: -surface_file {path}: {note[len('warning: '):]}", file=sys.stderr, flush=True)
+        elif not note.startswith("warning: "):
+            say(f"  surface: {note}")
+
+
+def report_interruption(settings, record):
+    """Rank 0: the one line of an interrupted run, naming what the files hold (nothing is written now)."""
+    files = " and ".join(path for path in (settings.output, settings.json) if path)
+    held = record.written
+    if files and held:
+        kept = f"; {files} {'keep' if ' and ' in files else 'keeps'} them"
+        kept += " (rerun with -resume to continue)" if settings.output else ""
+    else:
+        kept = "; nothing was written" if files else ""
+    unsaved = len(record.steps) - held if files else 0
+    if unsaved > 0:
+        kept += f"; {unsaved} later step(s) finished but not yet saved are solved again by a rerun"
+    print(f"roughpetsc: interrupted after {held if files else len(record.steps)} of {len(settings.steps)} "
+          f"step(s){kept}", file=sys.stderr, flush=True)
 
 
 def make_solver(settings, problem):
@@ -322,7 +454,10 @@ def whole_last_fields(record, comm, distributed, settings):
 
 
 def record_stresses(settings, record, grid, fields):
-    """The subsurface stresses of the last step at ``settings.stress_depths`` into ``record`` (rank 0)."""
+    """The subsurface stresses of the last step at ``settings.stress_depths`` into ``record`` (rank 0).
+
+    Returns the lines that report them.
+    """
     from .stresses import free_stresses, periodic_stresses
 
     pressure = fields.get("pressure")
@@ -336,9 +471,8 @@ def record_stresses(settings, record, grid, fields):
         depths = free_stresses(pressure, (grid.l0 / grid.n0, grid.l1 / grid.n1), settings.stress_depths,
                                settings.nu, settings.fft_effort)
     record.stresses = list(depths)
-    for depth in record.stresses:
-        print(f"  stresses at depth {depth.depth:.4g}: max von Mises {depth.max_von_mises:.4g} at node "
-              f"{depth.max_location}", flush=True)
+    return [f"  stresses at depth {depth.depth:.4g}: max von Mises {depth.max_von_mises:.4g} at node "
+            f"{depth.max_location}" for depth in record.stresses]
 
 
 def write_outputs(settings, record, grid, fields, with_h5=True):
@@ -350,7 +484,8 @@ def write_outputs(settings, record, grid, fields, with_h5=True):
     if settings.plot and not fields:  # every step taken from a file without fields
         print(f"roughpetsc: -plot: no fields to plot in {settings.output} (-output_fields none)", file=sys.stderr)
     elif settings.plot:
-        plots.plot_solution(settings.plot, grid, fields["pressure"], fields["gap"], record.steps)
+        adhesion = record.summary["adhesion"] if settings.adhesion is not None else None
+        plots.plot_solution(settings.plot, grid, fields["pressure"], fields["gap"], record.steps, adhesion)
 
 
 def step_line(step):
@@ -362,18 +497,22 @@ def step_line(step):
             f"{step['time_s']:8.3f}  {step['reason']}{flag}{plastic}")
 
 
-def solve_path(settings, solver, record, comm, say):
-    """Solve the loads of ``settings.steps`` not yet in ``record``, recording each and checkpointing -output.
+def solve_path(settings, solver, record, comm, lines, requests, progress=None):
+    """Solve the loads of ``settings.steps`` not yet in ``record``, recording each and checkpointing the files.
 
     Each step's pressure and gap are gathered on rank 0 for the record when
     ``settings.gather_fields``, or kept as this rank's rows when every rank writes its rows of the
     file (``record.first_row``). Every option must have been used once the
     first solve is done (PETSc reads viewers and converged reasons during and
     after TAOSolve); the check runs then, before any file is written.
+
+    Returns True when a stop was requested (``requests``, on any rank): the step that was running is
+    dropped, and nothing more is written. ``progress``: the :class:`roughpetsc.kkt.Progress` to tell
+    of each new step, or None.
     """
     from petsc4py import PETSc
 
-    from . import io
+    from .interrupts import agreed
     from .options import check_unused
     from .slab import gather_rows
 
@@ -382,19 +521,24 @@ def solve_path(settings, solver, record, comm, say):
     for index, (kind, value) in enumerate(steps):
         if index < len(record.steps):
             continue
+        if agreed(comm, requests.is_set()):
+            return True
+        if progress is not None:
+            progress.start_step(index, len(steps), kind, value)
         stage = PETSc.Log.Stage(f"RP step {index:03d} {kind}={value:g}")  # -log_view: one stage per load
         stage.push()
         try:
             result = solver.solve(**{kind: value})
         finally:
             stage.pop()
+        if agreed(comm, requests.is_set()) and not result.converged:
+            return True  # stopped by the request: solved again by a rerun
         solver_ran = not result.reason.startswith("COMPLETE_CONTACT")  # the exact answer runs no TAO
         if not checked:
             # Once a TAO solve has run, every option must have been read; before, only those that are
             # not read during or after a solve (a path wholly beyond complete contact runs none).
             check_unused(final=solver_ran)
             checked = solver_ran
-        say(step_line(result.summary()))
         if record.first_row is not None:
             fields = [field.copy() for field in solver.fields()]
         elif settings.gather_fields:
@@ -402,15 +546,24 @@ def solve_path(settings, solver, record, comm, say):
         else:
             fields = [None, None]
         record.add(dict(result.summary(), load_option=kind, load_value=value), result.history, *fields)
-        if settings.output and index < len(steps) - 1:  # every rank takes part: a failed write stops them all
-            if record.first_row is not None:
-                if comm.bcast(record.due(), root=0):  # rank 0's clock decides for all
-                    record.write(settings.output, comm=comm)
-            else:
-                io.on_root(comm, checkpoint, record, settings.output)
+        lines.add(step_line(result.summary()))
+        # Not before every option is known to be used: a run refused for an unused option writes nothing.
+        if checked and index < len(steps) - 1 and checkpoint(settings, record, comm):
+            lines.flush()
+    return False
 
 
-def checkpoint(record, h5_path):
-    """Rewrite ``h5_path`` with the steps so far when it is time to (rank 0)."""
-    if record.due():
-        record.write(h5_path)
+def checkpoint(settings, record, comm):
+    """Rewrite the files (-output, -json) with the steps so far when it is time to; True if they were written.
+
+    Every rank takes part: a failed write stops them all. Rank 0's clock decides for all.
+    """
+    from . import io
+
+    if not (settings.output or settings.json) or not comm.bcast(record.due(), root=0):
+        return False
+    if record.first_row is not None:
+        record.write(settings.output, settings.json, comm=comm)
+    else:
+        io.on_root(comm, record.write, settings.output, settings.json)
+    return True

@@ -72,6 +72,75 @@ def power_spectrum(grid, field):
     return power
 
 
+def radial_bin_width(grid):
+    """The width of the annuli of :func:`radial_psd_sums`: the fundamental wavenumber 1 / max(l0, l1) [cycles/length]."""
+    return 1.0 / max(grid.l0, grid.l1)
+
+
+def mode_psd(grid, field):
+    """``(|k|, S, multiplicity)`` of every mode of the ``rfft2`` layout of a periodic field.
+
+    ``S(k) = |DFT(f)_k|^2 A / (n0 n1)^2`` is the PSD estimate whose expectation is the PSD of (2.12)
+    that :func:`roughpetsc.surfaces.fractal` filters by ((2.18) for its surfaces); ``multiplicity``
+    counts the Hermitian twin a column stands for. Units: |k| cycles/length, S [field]^2 length^2.
+    """
+    k0, k1 = grid.rfft_wavenumbers()
+    multiplicity = np.broadcast_to(rfft_multiplicity(grid.n1), (grid.n0, grid.n1 // 2 + 1))
+    psd = power_spectrum(grid, field) * grid.area / multiplicity
+    return np.hypot(k0, k1), psd, multiplicity
+
+
+def radial_psd_sums(grid, field):
+    """Sums of the PSD over annuli of |k|, to average over annuli and surfaces: ``{"modes", "psd"}`` arrays.
+
+    Annulus ``b = 1, 2, ...`` holds the modes with ``round(|k| / dk) = b`` (:func:`radial_bin_width`) up
+    to the Nyquist wavenumber of the coarser direction, where the annuli are whole; ``modes`` counts
+    them and ``psd`` sums their S (:func:`mode_psd`).
+    """
+    k, psd, multiplicity = mode_psd(grid, field)
+    width = radial_bin_width(grid)
+    count = int(np.floor(min(grid.n0 / grid.l0, grid.n1 / grid.l1) / 2.0 / width + 1e-9))
+    annulus = np.rint(k / width).astype(int)
+    inside = (annulus >= 1) & (annulus <= count)
+    index = annulus[inside] - 1
+    return {"modes": np.bincount(index, multiplicity[inside], count),
+            "psd": np.bincount(index, (multiplicity * psd)[inside], count)}
+
+
+def radial_psd(grid, sums):
+    """The radially averaged PSD of :func:`radial_psd_sums` (summed over surfaces): ``(k, psd, modes)``.
+
+    ``k`` is the centre of each annulus (b dk) [cycles/length], ``psd`` the mean S over its modes.
+    """
+    k = radial_bin_width(grid) * np.arange(1, sums["modes"].size + 1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return k, np.where(sums["modes"] > 0, sums["psd"] / sums["modes"], np.nan), sums["modes"]
+
+
+def fit_fractal_psd(grid, field, band):
+    """Fit (2.18), ``S = C k^-2(1+H)``, to the PSD of the modes of a periodic field with ``|k|`` in ``band``.
+
+    H from the least-squares line ln S = ln C - 2 (1 + H) ln k over the modes (the log of a random
+    amplitude's power has a constant bias, which moves the line but not its slope), then C as the mean
+    of S k^2(1+H) over them (unbiased for random amplitudes). Both are exact for a PSD that is exactly
+    (2.18) in the band (``generator="xu"``). ``band = (k_min, k_max)`` in cycles/length.
+
+    Returns ``{"hurst", "C", "modes", "rms_log_residual"}`` (C in [field]^2 length^(4 - 2H)), or None
+    when fewer than two distinct |k| with power lie in the band.
+    """
+    k, psd, multiplicity = mode_psd(grid, field)
+    chosen = (k >= band[0] * (1 - 1e-12)) & (k <= band[1] * (1 + 1e-12)) & (psd > 0)
+    if np.unique(k[chosen]).size < 2:
+        return None
+    w, x, y = multiplicity[chosen], np.log(k[chosen]), np.log(psd[chosen])
+    mean_x, mean_y = np.average(x, weights=w), np.average(y, weights=w)
+    slope = np.sum(w * (x - mean_x) * (y - mean_y)) / np.sum(w * (x - mean_x) ** 2)
+    residual = y - mean_y - slope * (x - mean_x)
+    amplitude = np.average(psd[chosen] * k[chosen] ** -slope, weights=w)
+    return {"hurst": float(-slope / 2.0 - 1.0), "C": float(amplitude), "modes": float(np.sum(w)),
+            "rms_log_residual": float(np.sqrt(np.average(residual ** 2, weights=w)))}
+
+
 def spectral_moments_from_power(grid, power, orders=MOMENT_ORDERS):
     """Directional moments (2.12)-(2.13) as sums over a discrete power spectrum.
 

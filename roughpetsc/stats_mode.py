@@ -24,12 +24,12 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from . import asperities, mode_settings, seeds, spectra
+from . import asperities, mode_settings, seeds, spectra, surfaces
 from .errors import ParameterError, UserError
 from .io import check_outputs, on_root
 from .mode_settings import Option
 from .stats_output import FIELDS, closed_form_pdfs, report, result_document
-from .surfaces import SURFACE_OPTIONS, fractal_amplitude, from_options
+from .surfaces import fractal_amplitude, from_options
 
 OPTIONS = [
     Option("stats_ensemble", 0, "number of realisations (seeds from -ensemble_seed, as in -mode ensemble); 0 = "
@@ -42,6 +42,10 @@ OPTIONS = [
     Option("stats_bin_width", 0.25, "bin width of the PDF histograms, in units of sqrt(m0) or sqrt(m4)"),
     Option("stats_fd_scheme", "seed", "finite-difference stencils of (7.6)/(7.7): seed (the dissertation's) | "
                                       "central"),
+    Option("stats_psd", "", "write the radially averaged PSD of the surface(s) to PATH (CSV: k, PSD, modes, the fit) "
+                            "with the fit of (2.18) C k^-2(1+H) over -stats_psd_band"),
+    Option("stats_psd_band", "", "k_min,k_max [cycles/length] of the PSD fit; default k_l,k_s of a fractal "
+                                 "surface, else the fundamental to the Nyquist wavenumber"),
 ]
 
 PDF_RANGE = (-5.0, 5.0)
@@ -63,6 +67,8 @@ class StatsSettings:
     bin_width: float
     fd_scheme: str
     e_star: float
+    psd: str = ""
+    psd_band: tuple = None
 
     def record(self):
         """``{name: value}`` of the settings: the document's ``settings`` (``e_star`` and ``fd_scheme`` are
@@ -76,7 +82,8 @@ def read_settings(options):
     settings = StatsSettings(
         ensemble=given["stats_ensemble"], ensemble_seed=given["ensemble_seed"], json=given["stats_json"],
         h5=given["stats_h5"], plot=given["stats_plot"], bin_width=given["stats_bin_width"],
-        fd_scheme=given["stats_fd_scheme"], e_star=mode_settings.check_modulus(options.getReal("E_star", 1.0)))
+        fd_scheme=given["stats_fd_scheme"], e_star=mode_settings.check_modulus(options.getReal("E_star", 1.0)),
+        psd=given["stats_psd"], psd_band=psd_band(options, given))
     if settings.ensemble < 0:
         raise UserError(f"-stats_ensemble must be >= 0, got {settings.ensemble}")
     if settings.ensemble_seed < 0:
@@ -91,16 +98,38 @@ def read_settings(options):
     return settings
 
 
+def psd_band(options, given):
+    """``-stats_psd_band`` as ``(k_min, k_max)``; that of a fractal surface of the options, or None (the fundamental
+    to the Nyquist wavenumber of each surface) when not given. Read only with ``-stats_psd``."""
+    if not given["stats_psd"]:
+        return None
+    from .loads import parse_reals
+
+    if options.hasName("stats_psd_band"):
+        band = parse_reals(given["stats_psd_band"], "stats_psd_band")
+        if len(band) != 2 or not (0 < band[0] < band[1] and np.isfinite(band[1])):
+            raise UserError(f"-stats_psd_band: give k_min,k_max with 0 < k_min < k_max, got '{given['stats_psd_band']}'")
+        return tuple(band)
+    if mode_settings.is_random_surface(options):
+        _, surface = mode_settings.fractal_parameters(options)
+        return surface["kl"], surface["ks"]
+    return None
+
+
 def output_paths(settings):
     """The files the run writes, as ``(option, path)``."""
     plot = settings.plot
-    return [("stats_json", settings.json), ("stats_h5", settings.h5),
+    return [("stats_json", settings.json), ("stats_h5", settings.h5), ("stats_psd", settings.psd),
             ("stats_plot", f"{plot}_h.png" if plot else ""), ("stats_plot", f"{plot}_p.png" if plot else "")]
 
 
 def surface_settings(options):
-    """The surface options as read (for the record): ``{name: value}``, typed by their defaults."""
-    return mode_settings.read_table(options, SURFACE_OPTIONS)
+    """The surface options this run uses, as read (for the record): ``{name: value}``, typed by their defaults.
+
+    Those of the surface type (:func:`roughpetsc.surfaces.parameters`), so that one the run does not use
+    is reported as unused.
+    """
+    return surfaces.parameters(options)
 
 
 def histogram_edges(bin_width):
@@ -147,13 +176,15 @@ def field_summit_statistics(grid, field, moments, edges, label):
 
 
 def surface_statistics(grid, heights, settings, edges):
-    """All per-surface quantities: ``(scalars, counts)``.
+    """All per-surface quantities: ``(scalars, counts, psd)``.
 
     ``scalars``: flat ``{name: float}`` with the directional and isotropic
     moments of h and p_c by finite differences (``_fd``) and from the spectrum
     (``_spec``), bandwidths, summit counts and GW inputs (measured and
     McCool's). ``counts``: ``{name: (bin counts, total)}`` of the dimensionless
-    heights, summit heights and curvatures of h and -p_c.
+    heights, summit heights and curvatures of h and -p_c. With ``-stats_psd``: ``psd`` the sums of the
+    radially averaged PSD (:func:`roughpetsc.spectra.radial_psd_sums`), and the fit of (2.18)
+    (:func:`roughpetsc.spectra.fit_fractal_psd`) among the scalars (``psd_hurst``, ``psd_C``); else None.
     """
     summary = spectra.surface_moment_summary(grid, heights, settings["e_star"], settings["fd_scheme"])
     scalars = {}
@@ -169,7 +200,21 @@ def surface_statistics(grid, heights, settings, edges):
         field_scalars, field_counts = field_summit_statistics(grid, field, moments, edges, label)
         scalars.update(field_scalars)
         counts.update(field_counts)
-    return scalars, counts
+    if not settings["psd"]:
+        return scalars, counts, None
+    band = settings["psd_band"] or default_psd_band(grid)
+    fit = spectra.fit_fractal_psd(grid, heights, band)
+    if fit is None:
+        raise UserError(f"-stats_psd_band: fewer than two wavenumbers of the {grid.n0}x{grid.n1} grid with power lie "
+                        f"in [{band[0]:g}, {band[1]:g}]")
+    scalars.update(psd_hurst=fit["hurst"], psd_C=fit["C"], psd_rms_log_residual=fit["rms_log_residual"])
+    return scalars, counts, spectra.radial_psd_sums(grid, heights)
+
+
+def default_psd_band(grid):
+    """The band of the PSD fit without -stats_psd_band for a surface that is not fractal: the fundamental
+    wavenumber to the Nyquist wavenumber of the coarser direction [cycles/length]."""
+    return spectra.radial_bin_width(grid), min(grid.n0 / grid.l0, grid.n1 / grid.l1) / 2.0
 
 
 # ----------------------------------------------------------------------------
@@ -184,14 +229,17 @@ def surface_seeds(settings):
     return seeds.surface_seeds(settings.ensemble_seed, settings.ensemble)
 
 
-def local_statistics(options, settings, seeds, edges, rank, size):
-    """Statistics of the surfaces dealt to this rank: list of ``(index, seed, scalars, counts, grid)``."""
+def local_statistics(options, settings, seeds, edges, rank, size, levelling=None):
+    """Statistics of the surfaces dealt to this rank: list of ``(index, seed, scalars, counts, grid, psd)``.
+
+    ``levelling``: a list that receives the :class:`roughpetsc.surfaces.Levelling` of a surface file.
+    """
     results = []
     for index in range(rank, len(seeds), size):
         with mode_settings.options_named():
-            grid, heights = from_options(options, seed=seeds[index])
-        scalars, counts = surface_statistics(grid, heights, settings, edges)
-        results.append((index, seeds[index], scalars, counts, grid))
+            grid, heights = from_options(options, seed=seeds[index], notes=levelling)
+        scalars, counts, psd = surface_statistics(grid, heights, settings, edges)
+        results.append((index, seeds[index], scalars, counts, grid, psd))
     return results
 
 
@@ -224,7 +272,10 @@ def ensemble_summary(ordered, edges):
     pooled = {}
     for name in ordered[0][3]:
         pooled[name] = (sum(entry[3][name][0] for entry in ordered), sum(entry[3][name][1] for entry in ordered))
-    return {"per_surface": table, "mean": mean, "std": std, "counts": pooled, "edges": edges}
+    psd = None
+    if ordered[0][5] is not None:  # the PSD sums in seed order
+        psd = {name: sum(entry[5][name] for entry in ordered) for name in ordered[0][5]}
+    return {"per_surface": table, "mean": mean, "std": std, "counts": pooled, "edges": edges, "psd": psd}
 
 
 # ----------------------------------------------------------------------------
@@ -269,15 +320,17 @@ def pdf_distances(summary):
 # Entry point
 # ----------------------------------------------------------------------------
 
-def compute(options, comm):
-    """Compute the statistics on all ranks; the result document on rank 0, None elsewhere."""
-    settings = read_settings(options)
+def compute(options, comm, settings, surface):
+    """Compute the statistics on all ranks; the result document on rank 0, None elsewhere.
+
+    ``settings`` are :func:`read_settings` of ``options``, ``surface`` :func:`surface_settings`.
+    """
     record = settings.record()
-    surface = surface_settings(options)
     realisation_seeds = surface_seeds(settings)
     edges = histogram_edges(settings.bin_width)
+    levelling = []
     try:
-        local = local_statistics(options, record, realisation_seeds, edges, comm.rank, comm.size)
+        local = local_statistics(options, record, realisation_seeds, edges, comm.rank, comm.size, levelling)
     except (UserError, ParameterError) as error:  # raised on every rank by gather_in_seed_order, none left waiting
         local = mode_settings.user_message(error)
     ordered = gather_in_seed_order(comm, local)
@@ -285,8 +338,29 @@ def compute(options, comm):
         return None
     summary = ensemble_summary(ordered, edges)
     closed = closed_forms_from_options(options, record)
-    return result_document(summary, record, surface, closed, pdf_distances(summary), realisation_seeds,
-                           ordered[0][4])
+    document = result_document(summary, record, surface, closed, pdf_distances(summary), realisation_seeds,
+                               ordered[0][4])
+    if levelling:  # a surface file: one surface, on rank 0
+        document["surface_levelling"] = levelling[0].record()
+    if summary["psd"] is not None:
+        document["psd"] = psd_document(ordered[0][4], summary, settings.psd_band or default_psd_band(ordered[0][4]))
+    return document
+
+
+def psd_document(grid, summary, band):
+    """The radially averaged PSD over the surfaces and the fit of (2.18), as written by ``-stats_psd``.
+
+    The fit is the mean over the surfaces of each one's H and C (:func:`roughpetsc.spectra.fit_fractal_psd`).
+    """
+    k, psd, modes = spectra.radial_psd(grid, summary["psd"])
+    hurst, amplitude = summary["mean"]["psd_hurst"], summary["mean"]["psd_C"]
+    inside = (k >= band[0] * (1 - 1e-12)) & (k <= band[1] * (1 + 1e-12))
+    return {"k": k.tolist(), "psd": psd.tolist(), "modes": modes.tolist(),
+            "fit": np.where(inside, amplitude * k ** (-2.0 * (1.0 + hurst)), np.nan).tolist(),
+            "hurst": hurst, "C": amplitude, "k_min": band[0], "k_max": band[1],
+            "hurst_std": summary["std"]["psd_hurst"], "C_std": summary["std"]["psd_C"],
+            "m2_of_fit": float(amplitude * (2 * np.pi) ** 3 * (band[1] ** (2 - 2 * hurst) - band[0] ** (2 - 2 * hurst))
+                               / (4 * (1 - hurst))) if hurst < 1 else None}
 
 
 def run(options, comm):
@@ -302,13 +376,14 @@ def run(options, comm):
     The result document (dict) on rank 0, None on the other ranks.
     Raises :class:`UserError` on bad input (on every rank).
     """
+    from .options import check_unused  # imports PETSc: only once the command line has initialised it
+
     settings = read_settings(options)
+    surface = surface_settings(options)
     # Rank 0 checks the files and writes them; a failure there is raised on every rank (no rank left waiting).
     on_root(comm, check_outputs, output_paths(settings), options.getBool("overwrite", False),
             [("surface_file", options.getString("surface_file", ""))])
-    document = compute(options, comm)
+    check_unused()  # before any work: a run refused for an option it does not use computes and writes nothing
+    document = compute(options, comm, settings, surface)
     on_root(comm, report, document)
-    from .options import check_unused  # imports PETSc: only once the command line has initialised it
-
-    check_unused()
     return document

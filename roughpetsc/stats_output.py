@@ -109,6 +109,11 @@ def format_report(document):
         lines.append(f"{key:<16}{document['mean'][key]:>14.5g}{document['std'][key]:>12.3g}"
                      f"{closed.get(closed_key, float('nan')):>14.5g}"
                      f"{x if x is not None else float('nan'):>14.5g}{y if y is not None else float('nan'):>14.5g}")
+    psd = document.get("psd")
+    if psd is not None:
+        m2 = "" if psd["m2_of_fit"] is None else f", m2 of (7.1) with that band {psd['m2_of_fit']:.5g}"
+        lines.append(f"PSD fit of (2.18) over k in [{psd['k_min']:g}, {psd['k_max']:g}]: H = {psd['hurst']:.5g} "
+                     f"(std {psd['hurst_std']:.2g}), C = {psd['C']:.5g} (std {psd['C_std']:.2g}){m2}")
     lines.append("PDF L1 distances (binned, 2 x total variation; noise = expectation for an exact sample):")
     for name, entry in document["pdf_l1"].items():
         lines.append(f"  {name:<26}{entry['l1']:>8.4f}  noise {entry['l1_noise']:.4f}  vs {entry['closed_form']}"
@@ -117,7 +122,15 @@ def format_report(document):
 
 
 def report(document):
-    """Print the summary and write the requested files (rank 0)."""
+    """Print the summary and write the requested files (rank 0); the warnings of a surface file to stderr."""
+    import sys
+
+    for note in document.get("surface_levelling", {}).get("notes", []):
+        if note.startswith("warning: "):
+            print(f"roughpetsc: warning: -surface_file {document['surface_options']['surface_file']}: "
+                  f"{note[len('warning: '):]}", file=sys.stderr, flush=True)
+        else:
+            print(f"surface: {note}", flush=True)
     print(format_report(document), flush=True)
     settings = document["settings"]
     if settings["json"]:
@@ -126,3 +139,18 @@ def report(document):
         stats_file.write(settings["h5"], document)
     if settings["plot"]:
         plot_pdfs(settings["plot"], document)
+    if settings["psd"]:
+        write_psd(settings["psd"], document["psd"])
+
+
+def write_psd(path, psd):
+    """The radially averaged PSD and its fit as CSV (atomically): a commented header with the fit, then
+    ``k, psd, modes, fit`` per annulus (fit empty outside the band)."""
+    with atomic_path(path) as temporary, open(temporary, "w") as handle:
+        handle.write(f"# radially averaged PSD S(k), [height]^2 length^2, annuli of width {psd['k'][0]:g} "
+                     "cycles/length\n")
+        handle.write(f"# fit of (2.18) S = C k^-2(1+H) over k in [{psd['k_min']:g}, {psd['k_max']:g}]: "
+                     f"H = {psd['hurst']!r}, C = {psd['C']!r}\n")
+        handle.write("k,psd,modes,fit\n")
+        for k, value, modes, fit in zip(psd["k"], psd["psd"], psd["modes"], psd["fit"]):
+            handle.write(f"{k!r},{value!r},{int(modes)},{'' if not np.isfinite(fit) else repr(fit)}\n")

@@ -20,12 +20,26 @@ from .errors import ParameterError
 
 @dataclass(frozen=True)
 class Grid:
-    """A periodic cell of ``n0 x n1`` nodes and size ``l0 x l1`` (length units)."""
+    """A periodic cell of ``n0 x n1`` nodes and size ``l0 x l1`` (length units).
+
+    Raises :class:`ParameterError` naming ``n0``, ``n1``, ``l0`` or ``l1`` for a count of nodes that is
+    not a positive whole number or a side that is not positive and finite.
+    """
 
     n0: int
     n1: int
     l0: float = 1.0
     l1: float = 1.0
+
+    def __post_init__(self):
+        for name in ("n0", "n1"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+                raise ParameterError(name, f"the number of nodes {name} must be a positive whole number, got {value!r}")
+        for name in ("l0", "l1"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float, np.integer, np.floating)) and value > 0 and np.isfinite(value)):
+                raise ParameterError(name, f"the cell side {name} must be positive and finite, got {value!r}")
 
     @property
     def shape(self):
@@ -142,9 +156,27 @@ def check_waviness(amplitude, *wavelengths):
         raise ParameterError("wavelength", f"the wavelength must be positive, got {', '.join(map(str, wavelengths))}")
 
 
+def check_divides(cell, wavelength):
+    """Raise :class:`ParameterError` unless ``wavelength`` divides the periodic cell's side ``cell`` (length units).
+
+    A wave that does not fit a whole number of times into the cell is cut at the cell's edge, and the
+    periodic cell repeats that cut: another surface than the one asked for.
+    """
+    count = cell / wavelength
+    if not (round(count) >= 1 and abs(count - round(count)) <= 1e-9 * count):
+        raise ParameterError("wavelength", f"the wavelength {wavelength:g} does not divide the cell side {cell:g} "
+                                           f"({count:.6g} wavelengths); give the side divided by a whole number "
+                                           f"({cell:g}, {cell / 2:g}, {cell / 3:g}, ...)")
+
+
 def bisinusoid(grid, amplitude, wavelength0, wavelength1):
-    """Bisinusoidal waviness (3.52): Delta cos(2 pi y / lambda_y) cos(2 pi x / lambda_x), length units."""
+    """Bisinusoidal waviness (3.52): Delta cos(2 pi y / lambda_y) cos(2 pi x / lambda_x), length units.
+
+    Each wavelength must divide its side of the cell (:func:`check_divides`).
+    """
     check_waviness(amplitude, wavelength0, wavelength1)
+    check_divides(grid.l0, wavelength0)
+    check_divides(grid.l1, wavelength1)
     y, x = grid.coordinates()
     return amplitude * np.cos(2 * np.pi * y / wavelength0) * np.cos(2 * np.pi * x / wavelength1)
 
@@ -154,9 +186,11 @@ def wave(grid, amplitude, wavelength):
 
     The profile ``2 h sin^2(pi x / lambda)`` less its mean ``h``, i.e.
     ``-h cos(2 pi x / lambda)`` with ``h`` = ``amplitude``. Its complete-contact
-    pressure is ``p_star = pi E* h / lambda`` (Johnson, Contact Mechanics, 13.2).
+    pressure is ``p_star = pi E* h / lambda`` (Johnson, Contact Mechanics, 13.2). The wavelength must
+    divide the cell length (:func:`check_divides`).
     """
     check_waviness(amplitude, wavelength)
+    check_divides(grid.l1, wavelength)
     _, x = grid.coordinates()
     return np.broadcast_to(-amplitude * np.cos(2 * np.pi * x / wavelength), grid.shape).copy()
 
@@ -172,18 +206,24 @@ def hertz_sphere(grid, radius):
 
 
 def load(path):
-    """Read a surface from ``.npy``, HDF5 or a text matrix.
+    """Read a surface from ``.npy``, HDF5, CSV or a text file.
 
     HDF5: the dataset ``surface`` (contact-mechanics-challenge layout) or
     ``heights`` (a roughpetsc output, whose root attribute ``length`` records
-    the cell size ``[l0, l1]``).
+    the cell size ``[l0, l1]``). Other suffixes than those of :data:`TABLE_SUFFIXES`
+    are instrument files, read by SurfaceTopography (:func:`read_instrument`).
+    CSV (``.csv``, commas) and text (blanks) hold
+    a height matrix (rows along y, at least 4 columns) or an ``x y z`` point
+    list (three columns, one point a line) whose points lie on a uniform grid of
+    square nodes (:func:`points_to_grid`); one header line of words is skipped.
 
     Returns
     -------
     heights : ndarray (n0, n1), length units, zero mean.
     length : float or None
-        The recorded cell length along axis 1 (x), length units; None if the
-        file does not record one.
+        The recorded cell length along axis 1 (x), length units: that of a roughpetsc
+        file, or the number of columns times the node spacing of a point list; None
+        if the file does not record one.
 
     Raises :class:`ParameterError` (parameter ``path``) naming the file if it
     is missing, unreadable or not a finite 2-D array.
@@ -192,8 +232,8 @@ def load(path):
         raise ParameterError("path", f"no such file: {path}")
     try:
         heights, length = _read_array(path)
-    except ParameterError:
-        raise
+    except ParameterError as error:
+        raise ParameterError("path", str(error) if str(error).startswith(str(path)) else f"{path}: {error}") from None
     except Exception as exc:  # any reader failure is the file's fault
         raise ParameterError("path", f"{path}: cannot read it ({type(exc).__name__}: {exc})") from None
     try:
@@ -202,13 +242,21 @@ def load(path):
         raise ParameterError("path", f"{path}: {error}") from None
 
 
+# Files read as tables (a height matrix or an x y z point list) by their suffix; HDF5 and .npy by their own
+# readers; any other suffix by SurfaceTopography when that optional extra is installed (tools/surfacetopography.sh).
+TABLE_SUFFIXES = (".txt", ".csv", ".dat", ".asc", ".xyz", "")
+HDF5_SUFFIXES = (".h5", ".hdf5", ".hdf")
+
+
 def _read_array(path):
     """``(heights as stored, recorded length or None)`` of a surface file, by its suffix."""
     suffix = os.path.splitext(path)[1].lower()
     if suffix == ".npy":
         return np.load(path, allow_pickle=False), None
-    if suffix not in (".h5", ".hdf5", ".hdf"):
-        return np.loadtxt(path, ndmin=2), None
+    if suffix in TABLE_SUFFIXES:
+        return table_surface(read_table(path), path)
+    if suffix not in HDF5_SUFFIXES:
+        return read_instrument(path)
     import h5py
 
     with h5py.File(path, "r") as f:
@@ -218,6 +266,241 @@ def _read_array(path):
             length = float(json.loads(f.attrs["length"])[1]) if "length" in f.attrs else None
             return f["heights"][()], length
     raise ParameterError("path", f"{path}: no dataset 'surface' or 'heights' in the HDF5 file")
+
+
+def read_instrument(path):
+    """``(heights, cell length along x or None)`` of an instrument file, read by SurfaceTopography.
+
+    Rows of the result run along y. The length is the file's physical size along x (in the unit of
+    its heights), None where the file records none. Without SurfaceTopography (an optional extra,
+    ``bash tools/surfacetopography.sh``) the file is read as a table if it is one, else refused.
+    """
+    try:
+        from SurfaceTopography import open_topography
+    except ImportError:
+        try:
+            return table_surface(read_table(path), path)
+        except (ParameterError, UnicodeDecodeError):
+            raise ParameterError("path", f"{path}: not a format roughpetsc reads (.npy, HDF5, text, CSV); instrument "
+                                         "formats are read by SurfaceTopography, an optional extra: bash "
+                                         "tools/surfacetopography.sh") from None
+    reader = open_topography(path)
+    channel = reader.default_channel
+    sizes = channel.physical_sizes
+    # A file that records its physical sizes fixes them; one that does not gets unit node spacing.
+    topography = reader.topography() if sizes is not None else reader.topography(physical_sizes=channel.nb_grid_pts)
+    if topography.dim != 2 or not getattr(topography, "is_uniform", True):
+        raise ParameterError("path", f"{path}: a line scan or non-uniform data, not a surface on a grid")
+    heights = np.asarray(topography.heights()).T  # SurfaceTopography: axis 0 = x
+    if sizes is None:
+        return heights, None
+    nx, ny = channel.nb_grid_pts
+    if abs(sizes[0] / nx - sizes[1] / ny) > 1e-6 * sizes[0] / nx:
+        raise ParameterError("path", f"{path}: nodes {sizes[0] / nx:.6g} apart along x and {sizes[1] / ny:.6g} along "
+                                     "y: the grid needs square nodes")
+    return heights, float(sizes[0])
+
+
+def read_table(path):
+    """The numbers of a CSV or text file as a 2-D array; ``#`` comments and one header line of words are skipped.
+
+    The delimiter is the comma for ``.csv`` and for a file whose first line of numbers has one, else blanks.
+    """
+    with open(path) as handle:
+        lines = [line.split("#", 1)[0].strip() for line in handle]
+    lines = [line for line in lines if line]
+    if not lines:
+        raise ParameterError("path", "the file holds no numbers")
+    delimiter = "," if path.lower().endswith(".csv") or "," in lines[-1] else None
+
+    def numbers(line):
+        return [float(item) for item in line.split(delimiter)]
+
+    try:
+        numbers(lines[0])
+    except ValueError:  # a header of column names
+        lines = lines[1:]
+    rows = []
+    for number, line in enumerate(lines, 1):
+        try:
+            rows.append(numbers(line))
+        except ValueError:
+            raise ParameterError("path", f"a line of data is not numbers: '{line[:60]}'") from None
+    widths = {len(row) for row in rows}
+    if len(widths) != 1:
+        raise ParameterError("path", f"the lines hold different numbers of values ({', '.join(map(str, sorted(widths)))})")
+    return np.array(rows, dtype=float).reshape(len(rows), widths.pop())
+
+
+def table_surface(table, path):
+    """``(heights, length)`` of a table: an ``x y z`` point list (3 columns) or a height matrix (4 columns or more)."""
+    if table.shape[1] == 3 and table.shape[0] > 3:
+        return points_to_grid(table)
+    if table.shape[1] < 4:
+        raise ParameterError("path", f"{table.shape[0]} rows of {table.shape[1]} values: neither an x y z point list "
+                                     "(3 columns, one point a line) nor a height matrix (at least 4 columns)")
+    return table, None
+
+
+def _axis_nodes(values, name):
+    """The distinct coordinates ``values`` of a point list along one axis, checked to be equally spaced."""
+    nodes = np.unique(values)
+    if nodes.size < 2:
+        raise ParameterError("path", f"the points of the x y z list have a single {name} coordinate")
+    steps = np.diff(nodes)
+    spacing = (nodes[-1] - nodes[0]) / (nodes.size - 1)
+    if np.abs(steps - spacing).max() > 1e-6 * spacing:
+        raise ParameterError("path", f"the {name} coordinates of the x y z list are not equally spaced (steps "
+                                     f"{steps.min():.6g} to {steps.max():.6g}): the points do not lie on a grid")
+    return nodes, spacing
+
+
+def points_to_grid(points):
+    """The heights of an ``x y z`` point list on a uniform grid of square nodes: ``(heights, cell length along x)``.
+
+    Every node of the grid must be given exactly once; rows of the result run along y (axis 0),
+    columns along x. The cell is the grid's extent plus one spacing (the periodic cell repeats
+    the nodes). Raises :class:`ParameterError` with the figures when the points do not lie on such a grid.
+    """
+    x_nodes, dx = _axis_nodes(points[:, 0], "x")
+    y_nodes, dy = _axis_nodes(points[:, 1], "y")
+    if x_nodes.size * y_nodes.size != points.shape[0]:
+        raise ParameterError("path", f"{points.shape[0]} points of an x y z list, but their {x_nodes.size} x and "
+                                     f"{y_nodes.size} y coordinates make {x_nodes.size * y_nodes.size} nodes: the "
+                                     "points do not fill a grid")
+    if abs(dx - dy) > 1e-6 * max(dx, dy):
+        raise ParameterError("path", f"the x y z list has spacings {dx:.6g} along x and {dy:.6g} along y: the grid "
+                                     "needs square nodes")
+    column = np.rint((points[:, 0] - x_nodes[0]) / dx).astype(int)
+    row = np.rint((points[:, 1] - y_nodes[0]) / dy).astype(int)
+    heights = np.full((y_nodes.size, x_nodes.size), np.nan)
+    heights[row, column] = points[:, 2]
+    taken = np.zeros(heights.shape, dtype=int)
+    np.add.at(taken, (row, column), 1)
+    if taken.max() > 1:
+        raise ParameterError("path", f"the x y z list gives {int((taken > 1).sum())} node(s) more than once")
+    return heights, x_nodes.size * dx
+
+
+DETRENDS = ("none", "mean", "plane")
+
+
+def fit_plane(grid, heights):
+    """The least-squares plane of ``heights`` over the nodes: ``(mean, slope along x, slope along y)``.
+
+    Slopes in length / length; the plane is ``mean + slope_x (x - xc) + slope_y (y - yc)`` about the
+    cell's centre of nodes (xc, yc).
+    """
+    y, x = grid.coordinates()
+    x = np.broadcast_to(x - x.mean(), grid.shape)
+    y = np.broadcast_to(y - y.mean(), grid.shape)
+    mean = heights.mean()
+    slope_x = float(np.sum(x * (heights - mean)) / np.sum(x * x))
+    slope_y = float(np.sum(y * (heights - mean)) / np.sum(y * y)) if grid.n0 > 1 else 0.0
+    return float(mean), slope_x, slope_y
+
+
+def plane_heights(grid, slope_x, slope_y):
+    """The zero-mean plane ``slope_x (x - xc) + slope_y (y - yc)`` on the nodes, length units."""
+    y, x = grid.coordinates()
+    return slope_x * (x - x.mean()) + slope_y * (y - y.mean())
+
+
+@dataclass(frozen=True)
+class Levelling:
+    """What :func:`level` did to a measured surface and what it found, with the figures of its warnings.
+
+    ``slope_x``, ``slope_y``: the least-squares plane's slopes; ``removed``: whether it was removed;
+    ``tilt_rms``: the rms of that plane over the cell; ``rms``: the rms height of the surface used;
+    ``edge_jump``: :func:`edge_jumps` of the surface used; ``notes``: the lines to print (``warning: ...``
+    for a warning).
+    """
+
+    how: str
+    slope_x: float
+    slope_y: float
+    removed: bool
+    tilt_rms: float
+    rms: float
+    edge_jump: dict
+    notes: tuple
+
+    def record(self):
+        """A JSON-ready summary for the output files."""
+        return {"detrend": self.how, "plane_slope_x": self.slope_x, "plane_slope_y": self.slope_y,
+                "plane_removed": self.removed, "tilt_rms": self.tilt_rms, "rms": self.rms,
+                "edge_jump": {axis: list(values) for axis, values in self.edge_jump.items()},
+                "notes": list(self.notes)}
+
+
+# Edges are compared with neighbouring nodes: a periodic surface steps from its last column (row) to its first as
+# from any column to the next. A tilt makes that step a rise of the whole cell, a measurement that is not periodic
+# an rms jump, many times those of neighbours; warned of when also above this fraction of the rms height (a tilt
+# took alpha_h of a measured surface from 2.5 to 61).
+EDGE_WARNING = 0.25
+# ... and this many times the neighbours' rms step (jump) or the rms over the columns of their mean step (rise).
+EDGE_STEPS = 5.0
+
+
+def edge_jumps(heights):
+    """``{"x": (rise, rms mean step, jump, rms step), "y": ...}``: the last column (row) against the first.
+
+    ``rise`` is the mean of last - first (a tilt across the cell), ``jump`` the rms of that difference;
+    ``rms mean step`` is the rms over neighbouring columns (rows) of their mean difference, ``rms step``
+    the rms of their differences: what a periodic surface's edges would show. Length units.
+    """
+    found = {}
+    for axis, name in ((1, "x"), (0, "y")):
+        if heights.shape[axis] < 3:
+            continue
+        other = 1 - axis
+        difference = np.take(heights, -1, axis=axis) - np.take(heights, 0, axis=axis)
+        steps = np.diff(heights, axis=axis)
+        found[name] = (float(np.mean(difference)), float(np.sqrt(np.mean(np.mean(steps, axis=other) ** 2))),
+                       float(np.sqrt(np.mean(difference ** 2))), float(np.sqrt(np.mean(steps ** 2))))
+    return found
+
+
+def level(grid, heights, how="mean"):
+    """Level a measured surface: ``(heights, Levelling)``.
+
+    ``how``: ``none`` (as given), ``mean`` (the mean removed; the contact does not see it, the operator
+    has no k = 0 mode) or ``plane`` (the least-squares plane removed, :func:`fit_plane`). The heights
+    returned have zero mean whatever ``how`` (:func:`validate`). The notes report the plane removed,
+    and warn, with the figures, when a tilt left in place or a jump between opposite edges (a
+    measurement that is not periodic: the cell repeats it with a step) is large against the rms height.
+    """
+    if how not in DETRENDS:
+        raise ParameterError("detrend", f"the levelling is one of {', '.join(DETRENDS)}, got '{how}'")
+    _, slope_x, slope_y = fit_plane(grid, heights)
+    tilt = plane_heights(grid, slope_x, slope_y)
+    tilt_rms = float(np.sqrt(np.mean(tilt ** 2)))
+    removed = how == "plane"
+    if removed:
+        heights = heights - tilt
+    heights = validate(heights)
+    rms = float(np.sqrt(np.mean(heights ** 2)))
+    notes = []
+    slopes = f"slopes {slope_x:.4g} along x and {slope_y:.4g} along y"
+    jumps = edge_jumps(heights)
+    if removed:
+        notes.append(f"-surface_detrend plane removed the plane of {slopes} (rms {tilt_rms:.4g} over the cell); "
+                     f"rms height left {rms:.4g}")
+    else:
+        rises = {axis: rise for axis, (rise, mean_step, _, _) in jumps.items()
+                 if abs(rise) > EDGE_WARNING * rms and abs(rise) > EDGE_STEPS * mean_step}
+        if rises:
+            said = ", ".join(f"{rise:.4g} from the first to the last {'column' if axis == 'x' else 'row'} "
+                             f"({abs(rise) / rms:.3g} of the rms height {rms:.4g})" for axis, rise in rises.items())
+            notes.append(f"warning: the surface is tilted: its heights rise on average by {said}; its best-fit "
+                         f"plane has {slopes}; -surface_detrend plane levels it")
+    for axis, (_, _, jump, step) in jumps.items():
+        if jump > EDGE_STEPS * step and jump > EDGE_WARNING * rms:
+            notes.append(f"warning: the heights jump by {jump:.4g} rms ({jump / rms:.3g} of the rms height) between "
+                         f"the first and last {'columns' if axis == 'x' else 'rows'}, against {step:.4g} between "
+                         f"neighbours: the measurement is not periodic, and the periodic cell repeats it with a "
+                         f"step at its edges along {axis}")
+    return heights, Levelling(how, slope_x, slope_y, removed, tilt_rms, rms, jumps, tuple(notes))
 
 
 def validate(heights):
@@ -259,8 +542,11 @@ def square_grid(n1, n0=0, length=1.0):
 # The one place of these defaults: from_options, parameters and roughpetsc.presets read them here.
 SURFACE_OPTIONS = [
     ("surface_type", "fractal", "fractal | bisinusoid | wave | sphere (an error with -surface_file)"),
-    ("surface_file", "", "read heights from PATH (.npy, a text matrix, .h5/.hdf5 dataset 'surface', or a "
-                         "roughpetsc output: dataset 'heights' and its recorded cell length)"),
+    ("surface_file", "", "read heights from PATH: .npy, a text or CSV height matrix or x y z point list on a grid, "
+                         ".h5/.hdf5 dataset 'surface', a roughpetsc output (dataset 'heights' and its recorded "
+                         "cell length), or an instrument file (with the optional SurfaceTopography)"),
+    ("surface_detrend", "mean", "-surface_file: none | mean | plane (remove the least-squares plane, reported); a "
+                                "tilt or a jump between opposite edges large against the rms height is warned of"),
     ("surface_N", 256, "nodes per side (N x N grid)"),
     ("surface_N0", 0, "rows (axis 0) if different from -surface_N; e.g. a few rows for a 1-D wave"),
     ("surface_L", 1.0, "cell length along axis 1 (x); axis 0 gets L * N0 / N (square nodes)"),
@@ -307,10 +593,10 @@ def option_values(opts, names):
 def parameters(opts):
     """The surface's parameters as used, defaults included: ``{option name: value}`` (for output files).
 
-    A surface read from a file is recorded by its path and -surface_L.
+    A surface read from a file is recorded by its path, -surface_L and -surface_detrend.
     """
     if opts.getString("surface_file", ""):
-        return option_values(opts, ("surface_file", "surface_L"))
+        return option_values(opts, ("surface_file", "surface_L", "surface_detrend"))
     kind = opts.getString("surface_type", "fractal")
     return option_values(opts, ("surface_type", "surface_N", "surface_N0", "surface_L") + TYPE_OPTIONS.get(kind, ()))
 
@@ -321,21 +607,29 @@ def grid_from_options(opts):
     return square_grid(given["surface_N"], given["surface_N0"], given["surface_L"])
 
 
-def from_options(opts, seed=None):
+def from_options(opts, seed=None, notes=None):
     """Build the surface named by the options: ``(grid, heights)``, heights of shape ``grid.shape``.
 
     ``opts`` is a ``petsc4py.PETSc.Options`` (or anything with its ``get*``
     methods). ``seed`` overrides ``-surface_seed`` (ensembles). The full array
     is built on every rank, so the surface does not depend on the number of
-    ranks.
+    ranks. A surface file is levelled by ``-surface_detrend`` (:func:`level`); its
+    :class:`Levelling` is appended to the list ``notes`` if one is given.
     """
     path = opts.getString("surface_file", "")
     if path:
         heights, recorded_length = load(path)
-        # An explicit -surface_L wins over the length a roughpetsc file records.
+        # An explicit -surface_L wins over the length a file records.
         length = opts.getReal("surface_L", recorded_length or 1.0)
         n0, n1 = heights.shape
-        return square_grid(n1, n0, length), heights
+        grid = square_grid(n1, n0, length)
+        try:
+            heights, levelling = level(grid, heights, opts.getString("surface_detrend", "mean"))
+        except ParameterError as error:
+            raise ParameterError("detrend", str(error)) from None
+        if notes is not None:
+            notes.append(levelling)
+        return grid, heights
     grid = grid_from_options(opts)
     kind = opts.getString("surface_type", "fractal")
     if kind not in TYPE_OPTIONS:

@@ -17,6 +17,7 @@ replaced mpi4py-fft's PFFT, which was 3.5x slower on 2 ranks here
 import numpy as np
 from petsc4py import PETSc
 
+from .errors import ParameterError
 from .fftw import planner_effort
 from .spectra import rfft_multiplicity
 
@@ -184,6 +185,8 @@ class Westergaard(FilterOperator):
     """
 
     def __init__(self, grid, E_star, comm=None, threads=1, effort="FFTW_MEASURE"):
+        if not (isinstance(E_star, (int, float, np.integer, np.floating)) and E_star > 0 and np.isfinite(E_star)):
+            raise ParameterError("E_star", f"the composite modulus must be positive and finite, got {E_star!r}")
         comm = comm or PETSc.COMM_WORLD
         self.E_star = float(E_star)
         if comm.getSize() == 1:

@@ -1,6 +1,7 @@
 """Shared test set-up: PETSc initialised once; helpers to run the command line."""
 
 import os
+import pty
 import subprocess
 import sys
 
@@ -36,6 +37,26 @@ def run_cli(args, ranks=1, cwd=None, timeout=600):
     env = dict(os.environ, **MPI_ENV)
     env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
     return subprocess.run(command, capture_output=True, text=True, cwd=cwd or ROOT, env=env, timeout=timeout)
+
+
+def run_on_terminal(command, cwd=None):
+    """Run ``command`` (a list) with stdout on a pseudo-terminal; returns (exit status, what it printed)."""
+    primary, secondary = pty.openpty()
+    env = dict(os.environ, **MPI_ENV)
+    env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
+    run = subprocess.Popen(command, stdout=secondary, stderr=subprocess.PIPE, cwd=cwd or ROOT, env=env)
+    os.close(secondary)
+    printed = b""
+    while True:
+        try:
+            chunk = os.read(primary, 4096)
+        except OSError:  # the terminal closed with the process
+            break
+        if not chunk:
+            break
+        printed += chunk
+    os.close(primary)
+    return run.wait(timeout=300), printed.decode()
 
 
 def applications_at_time_limit(monkeypatch, problem):

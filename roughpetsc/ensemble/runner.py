@@ -173,6 +173,7 @@ class Ensemble:
         self.counter = WorkCounter(self.comm, self.todo, use_window=os.environ.get(
             "ROUGHPETSC_ENSEMBLE_COUNTER", "window") != "messages")
         self.received = 0              # records of this run that reached rank 0
+        self.saved = len(self.records)  # rank 0: surfaces in the file as last written
         self.write_error = None        # rank 0: why the file could not be written (then the run winds down)
         self.expected = len(self.todo)  # rank 0: records to wait for (fewer once the run winds down)
         self.sends = []
@@ -205,6 +206,7 @@ class Ensemble:
         records = sorted(self.records, key=lambda r: r["surface"]["index"])
         statistics = step_statistics(records, len(self.s.loads))
         ensemble_file.write(self.s.output, attrs, self.s.loads, records, statistics, models)
+        self.saved = len(records)
 
     def accept(self, record, group):
         """Rank 0: a finished surface (from any group) into the file, and one line of progress."""
@@ -331,6 +333,11 @@ def run(reader, comm):
         try:
             ensemble.work()
             return ensemble.finish()
+        except KeyboardInterrupt:  # Ctrl-C or SIGTERM: the file keeps every finished surface it was given
+            if ensemble.rank == 0:
+                print(f"roughpetsc: interrupted; {s.output} keeps {ensemble.saved} of {s.size} surfaces "
+                      "(rerun the same command to resume)", file=sys.stderr, flush=True)
+            return 130
         except Exception:     # a failure inside one group would leave the others waiting for ever
             traceback.print_exc()
             sys.stderr.flush()

@@ -143,11 +143,10 @@ def run(options, comm):
             options.getBool("overwrite", False))
     if o.models_plot:  # after the path checks, which name a folder as such
         check_figure_format(o.models_plot, "models_plot")
-    curves = on_root(comm, _compute_and_write, o)
     from ..options import check_unused  # imports PETSc: only once the command line has initialised it
 
-    check_unused()
-    return curves
+    check_unused()  # before any work: a run refused for an option it does not use prints and writes nothing
+    return on_root(comm, _compute_and_write, o)
 
 
 def _compute_and_write(o):

@@ -73,7 +73,8 @@ class _Scratch:
         self.work = np.empty(size)
         self.free = np.empty(size)
         self.open = np.empty(size, dtype=bool)
-        self.law = (np.empty(size), np.empty(size))  # the line search's parts of phi (energy_changes_from)
+        # the line search's parts of phi (interaction laws' energy_changes_from)
+        self.law = (np.empty(size), np.empty(size), np.empty(size))
         self.best = np.empty(size)  # an iterate near the lowest natural residual, returned by a stop short of it
 
 

@@ -39,6 +39,7 @@ class PKBackend(Backend):
         self.problem = problem
         self.control = control
         self.context = PolonskyKeer(problem, settings.rtol, settings.max_seconds)
+        self.prefix = settings.prefix
         tao = self.tao = PETSc.TAO().create(problem.comm)
         tao.setOptionsPrefix(settings.prefix)
         tao.setType(PETSc.TAO.Type.PYTHON)
@@ -55,6 +56,12 @@ class PKBackend(Backend):
     @property
     def name(self):
         return f"pk({self.context.preconditioner})"
+
+    def unusable_options(self):
+        """Options given for parts this TAO never runs (line search, KSP, PC, other TAO types): reported unused."""
+        from ..options import PARTS_UNUSED_BY_PYTHON_TAO, given_but_unusable
+
+        return given_but_unusable(PARTS_UNUSED_BY_PYTHON_TAO, self.prefix)
 
     def solve(self, target, pressure, guess):
         """Solve for ``target`` from ``pressure`` (overwritten), starting from ``guess.displacement`` if known."""

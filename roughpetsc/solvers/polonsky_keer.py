@@ -123,8 +123,14 @@ class PolonskyKeer:
                                           f"iterations, got {self.refresh}")
 
     def view(self, tao, viewer):
-        viewer.printfASCII(f"  Polonsky-Keer CG, active set {self.active_set}, preconditioner "
-                           f"{self.preconditioner}, K p refreshed every {self.refresh} iterations\n")
+        """-tao_view: PK's own settings; the line search and KSP that PETSc then lists are never used."""
+        limit = f"{self.max_seconds:g} s" if self.max_seconds > 0 else "none"
+        for line in (f"Polonsky-Keer CG, active set {self.active_set}, preconditioner {self.preconditioner}, K p "
+                     f"refreshed every {self.refresh} iterations",
+                     f"stops at a natural KKT residual (and load error) of {self.rtol:g}; time limit {limit}",
+                     "(PETSc lists below the line search and KSP that every TAO holds: Polonsky-Keer uses neither, "
+                     "and their options are reported as unused)"):
+            viewer.printfASCII(f"  {line}\n")
 
     def destroy(self, tao=None):
         for v in self.vecs:

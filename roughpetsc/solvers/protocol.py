@@ -18,6 +18,8 @@ certificate on a fresh gap fails (the resume of Polonsky-Keer along a load path)
 
 from dataclasses import dataclass
 
+import re
+
 import numpy as np
 from petsc4py import PETSc
 
@@ -107,6 +109,23 @@ def reason_name(reason):
         if not name.startswith("_") and value == reason and name not in ("ITERATING", "CONVERGED_ITERATING"):
             return name
     return str(reason)
+
+
+# The note of describe_stop that quotes the residual of the solver's best iterate.
+BEST_NOTE = re.compile(r"best (of natural residual, load error|natural residual) [^,)]+")
+
+
+def quote_certificate(reason, kkt):
+    """``reason`` with its residual note quoting the result as certified (:class:`~roughpetsc.kkt.KKTReport`).
+
+    A solver's own best residual (ALMM's merit, on its cached gap, of an iterate it may not return) can
+    differ from the certificate of the result, which the output files record: a stop reason quotes the
+    latter, so that the line and the files give the same numbers.
+    """
+    measured = f"natural residual {kkt.natural:.2g}"
+    if kkt.load_error is not None:
+        measured += f", load error {kkt.load_error:.2g}"
+    return BEST_NOTE.sub(measured, reason, count=1)
 
 
 def describe_stop(tao, test, restarts=0):

@@ -15,7 +15,7 @@ from ..contact import Result, measure
 from ..errors import ParameterError
 from ..kkt import report
 from .continuation import LoadContinuation
-from .protocol import Guess, Outcome
+from .protocol import Guess, Outcome, quote_certificate
 from .registry import make_backend
 
 
@@ -65,6 +65,10 @@ class Solver:
     def tao(self):
         """The backend's TAO object (the inner one of the root find): for monitors and views."""
         return self.backend.tao
+
+    def unusable_options(self):
+        """Options given that the backend read but cannot use (Polonsky-Keer has no line search or KSP)."""
+        return getattr(self.backend, "unusable_options", list)()
 
     def solve(self, pbar=None, pstar=None, gbar=None):
         """Solve one load; the previous solution is the start. Returns a :class:`Result`.
@@ -134,7 +138,7 @@ class Solver:
         kkt = report(problem.mpi, p, g, problem.n, target, problem.upper_bound)
         measures = measure(problem, p, g)
         converged = kkt.natural <= self.rtol and (kkt.load_error is None or kkt.load_error <= self.rtol)
-        reason = outcome.reason
+        reason = outcome.reason if converged else quote_certificate(outcome.reason, kkt)
         if not converged and reason.startswith(("CONVERGED", "COMPLETE")):
             # The solver's own test passed on its own gap; the certificate on a fresh one did not.
             load = "" if kkt.load_error is None else f", load error {kkt.load_error:.2g}"

@@ -1,0 +1,186 @@
+"""Issue 37, options: every value used as given or refused by name (valueless options, long lists, lists from
+files, -pbar_list, options files, -version, the wisdom file, -progress_interval, unused options in every mode)."""
+
+import json
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import run_cli
+from test_newcomer import assert_one_clear_error
+
+TINY = ["-surface_N", 32, "-surface_ks", 8, "-surface_kl", 2, "-fft_effort", "FFTW_ESTIMATE"]
+
+
+# --- an option of ours given without a value ------------------------------------------------------------------
+
+@pytest.mark.parametrize("args, named", [
+    (["-gbar"], "-gbar"),                              # was: displacement control at the p* default 0.5
+    (["-pstar"], "-pstar"),
+    (["-gbar", ""], "-gbar"),                          # an empty value is no value
+    (["-surface_file"], "-surface_file"),              # was: the generated surface solved
+    (["-pstar_list", "-quiet"], "-pstar_list"),        # the next option is not a value
+    (["-output", "-json", "x.json"], "-output"),      # was: nothing written, exit 0
+    (["-kkt_rtol"], "-kkt_rtol"),
+    (["-pk_pc"], "-pk_pc"),                            # a solver option of ours
+    (["-mode"], "-mode"),
+])
+def test_an_option_without_a_value_is_refused(tmp_path, args, named):
+    out = run_cli(TINY + args, cwd=tmp_path)
+    message = assert_one_clear_error(out, named, "without a value")
+    assert out.stdout == "" and not list(tmp_path.iterdir()), message
+
+
+def test_every_valueless_option_is_named(tmp_path):
+    out = run_cli(TINY + ["-output", "-json"], cwd=tmp_path)
+    assert_one_clear_error(out, "-json", "-output", "without a value")
+
+
+def test_valueless_in_an_options_file_is_refused(tmp_path):
+    (tmp_path / "mine.opts").write_text("# a load without its value\n-gbar\n")
+    out = run_cli(TINY + ["-options_file", tmp_path / "mine.opts"], cwd=tmp_path)
+    assert_one_clear_error(out, "-gbar", "without a value")
+
+
+@pytest.mark.parametrize("switch", [["-quiet"], ["-quiet", "1"], ["-quiet", "true"], ["-overwrite", "-quiet"]])
+def test_switches_stand_alone(tmp_path, switch):
+    out = run_cli(TINY + switch + ["-json", tmp_path / "s.json"])
+    assert out.returncode == 0, out.stderr
+    assert out.stdout == ""  # -quiet took effect
+    assert json.load(open(tmp_path / "s.json"))["steps"][0]["converged"]
+
+
+def test_a_negative_value_is_a_value_not_an_option(tmp_path):
+    out = run_cli(TINY + ["-pbar", -1], cwd=tmp_path)
+    assert_one_clear_error(out, "-pbar", "positive", "-1")
+
+
+# --- load lists: whole, from files, in pressure units -----------------------------------------------------------
+
+def long_list(count):
+    """``count`` increasing p*, written with many digits: far beyond the 1023 characters of petsc4py's buffer."""
+    return [0.05 + 0.0012345678901 * i for i in range(count)]
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_long_load_list_is_read_whole(tmp_path, ranks):
+    loads = long_list(150)
+    text = ",".join(repr(v) for v in loads)
+    assert len(text) > 2000
+    out = run_cli(TINY + ["-pstar_list", text, "-json", tmp_path / "l.json", "-quiet"], ranks=ranks)
+    assert out.returncode == 0, out.stderr
+    steps = json.load(open(tmp_path / "l.json"))["steps"]
+    assert len(steps) == 150
+    assert [step["pstar"] for step in steps] == pytest.approx(loads, rel=1e-7)
+
+
+def test_a_long_gbar_list_is_read_whole(tmp_path):
+    gaps = list(np.linspace(2e-3, 1e-3, 160))
+    text = ",".join(repr(float(v)) for v in gaps)
+    out = run_cli(TINY + ["-gbar_list", text, "-json", tmp_path / "g.json", "-quiet"])
+    assert out.returncode == 0, out.stderr
+    steps = json.load(open(tmp_path / "g.json"))["steps"]
+    assert [step["gbar"] for step in steps] == pytest.approx(gaps, rel=1e-9)
+
+
+def test_a_list_from_a_file(tmp_path):
+    loads = long_list(40)
+    lines = ["# p* of the path, one or several a line"] + [f"{a!r}, {b!r}" for a, b in zip(loads[::2], loads[1::2])]
+    (tmp_path / "loads.txt").write_text("\n".join(lines) + "\n")
+    out = run_cli(TINY + ["-pstar_list", "@loads.txt", "-json", "f.json", "-quiet"], cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    steps = json.load(open(tmp_path / "f.json"))["steps"]
+    assert [step["pstar"] for step in steps] == pytest.approx(loads, rel=1e-7)
+
+
+def test_pbar_list_loads_in_pressure_units(tmp_path):
+    out = run_cli(TINY + ["-pstar", 0.3, "-json", tmp_path / "p.json", "-quiet"])
+    assert out.returncode == 0, out.stderr
+    reference = json.load(open(tmp_path / "p.json"))
+    sqrt_m0p = reference["sqrt_m0p"]
+    pbars = [0.1 * sqrt_m0p, 0.3 * sqrt_m0p]
+    out = run_cli(TINY + ["-pbar_list", ",".join(repr(p) for p in pbars), "-json", tmp_path / "b.json", "-quiet"])
+    assert out.returncode == 0, out.stderr
+    steps = json.load(open(tmp_path / "b.json"))["steps"]
+    assert [step["pbar"] for step in steps] == pytest.approx(pbars, rel=1e-8)
+    assert [step["load_option"] for step in steps] == ["pbar", "pbar"]
+    # The same load by p*: the same contact area (the solutions agree to the tolerance).
+    assert steps[1]["A"] == pytest.approx(reference["steps"][0]["A"], abs=2.0 / 32 ** 2)
+
+
+@pytest.mark.parametrize("args, named", [
+    (["-pstar_list", "@missing.txt"], "missing.txt"),
+    (["-pstar_list", "@empty.txt"], "holds no numbers"),
+    (["-pstar_list", "@words.txt"], "'two'"),
+    (["-pbar_list", "1e-4,-2e-4"], "-pbar_list"),
+    (["-gbar_list", "1e-3,,2e-3"], "empty item"),
+    (["-pstar_list", "0.1", "-pbar_list", "1e-4"], "give only one of"),
+])
+def test_bad_lists_are_refused(tmp_path, args, named):
+    (tmp_path / "empty.txt").write_text("# nothing\n\n")
+    (tmp_path / "words.txt").write_text("0.1 two 0.3\n")
+    out = run_cli(TINY + args, cwd=tmp_path)
+    assert_one_clear_error(out, named)
+    assert out.stdout == ""
+
+
+# --- options files, -version, wisdom, progress interval -------------------------------------------------------
+
+@pytest.mark.parametrize("content", [b"1 2 3\n", b"hello world\n-pstar 0.5\n", b"\x00\xff\x01binary"])
+def test_a_file_that_is_not_an_options_file_is_named(tmp_path, content):
+    (tmp_path / "not.opts").write_bytes(content)
+    out = run_cli(TINY + ["-options_file", "not.opts"], cwd=tmp_path)
+    assert_one_clear_error(out, "-options_file", "not.opts")
+    assert "PETSC ERROR" not in out.stderr
+
+
+def test_version_names_roughpetsc_and_petsc():
+    from petsc4py import PETSc
+
+    import roughpetsc
+
+    out = run_cli(["-version"])
+    assert out.returncode == 0, out.stderr
+    first, second = out.stdout.splitlines()[:2]
+    assert first == f"roughpetsc {roughpetsc.__version__}"
+    assert f"PETSc {'.'.join(map(str, PETSc.Sys.getVersion()))}" in second
+    assert "A*" not in out.stdout  # nothing is solved
+
+
+@pytest.mark.parametrize("args, named", [
+    (["-fft_wisdom", "/no/such/folder/w.json"], "does not exist"),
+    (["-progress_interval", -1], "-progress_interval"),
+    (["-progress_interval", 0], "-progress_interval"),
+    (["-progress", "sometimes"], "-progress"),
+])
+def test_settings_that_would_do_nothing_are_refused(tmp_path, args, named):
+    out = run_cli(TINY + args, cwd=tmp_path)
+    assert_one_clear_error(out, named)
+
+
+# --- the unused-option check runs before any work, in every mode ------------------------------------------------
+
+@pytest.mark.parametrize("mode, output", [("models", "-models_json"), ("stats", "-stats_json")])
+def test_an_unused_option_stops_a_mode_before_it_prints_or_writes(tmp_path, mode, output):
+    surface = TINY[:6] if mode == "stats" else []
+    out = run_cli(surface + ["-mode", mode, "-pstar", 0.5, output, tmp_path / "m.json"])
+    assert_one_clear_error(out, "-pstar", "not used")
+    assert out.stdout == ""
+    assert not (tmp_path / "m.json").exists()
+    again = run_cli(surface + ["-mode", mode, output, tmp_path / "m.json"])  # the corrected command runs
+    assert again.returncode == 0, again.stderr
+
+
+def test_stats_reports_an_option_of_another_surface_type(tmp_path):
+    out = run_cli(TINY[:6] + ["-mode", "stats", "-surface_radius", 3])
+    assert_one_clear_error(out, "-surface_radius", "not used")
+
+
+def test_nothing_is_written_when_an_option_is_unused(tmp_path):
+    """A path starting beyond complete contact runs no TAO first; the check still precedes every write."""
+    out = run_cli(TINY + ["-pstar_list", "40,41,0.5", "-output", tmp_path / "o.h5", "-tao_view_x", 1])
+    assert out.returncode == 2, out.stderr
+    assert not (tmp_path / "o.h5").exists()
+    with pytest.raises(FileNotFoundError):
+        h5py.File(tmp_path / "o.h5", "r")
