@@ -47,7 +47,7 @@ def group_heights(grid, number, seed):
 
 def bem_cycle(problem, law, pmax):
     """(p*, 1 - A*, g*, converged) along loading then unloading (rows), and the number of steps loaded."""
-    from roughpetsc.adhesive import AdhesiveContact
+    from roughpetsc.contact.adhesive import AdhesiveContact
 
     adhesive = AdhesiveContact(problem, law, rtol=1e-8)
     rows = []
@@ -70,8 +70,9 @@ def bem_cycle(problem, law, pmax):
 
 def run_cycle(n, number, ratio, seed, pmax):
     """One BEM cycle and the model along it: a JSON-ready dict."""
-    from roughpetsc import ContactProblem, Grid, surface_moments
-    from roughpetsc.interaction import Dugdale
+    from roughpetsc import ContactProblem, Grid
+    from roughpetsc.surface import moments as surface_moments
+    from roughpetsc.contact.laws import Dugdale
     from roughpetsc.models.adhesion import AdhesiveGW
 
     grid = Grid(n, n)

@@ -29,7 +29,7 @@ SCAN_RANGE, SCAN_PEAKS, SCAN_GSTAR = 0.2, (0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0,
 
 
 def laws(problem):
-    from roughpetsc.interaction import Dugdale, Exponential
+    from roughpetsc.contact.laws import Dugdale, Exponential
 
     for name, range_, peak in CASES:
         range_ *= problem.sqrt_m0h
@@ -79,7 +79,7 @@ def reference_solve(problem, gbar, rtol):
 
 def adhesive_solve(problem, law, gbar, rtol):
     """The adhesive solve of ``law`` at the mean gap ``gbar`` from the rigid start (the gap CG)."""
-    from roughpetsc.adhesive import AdhesiveContact
+    from roughpetsc.contact.adhesive import AdhesiveContact
 
     adhesive = AdhesiveContact(problem, law, rtol=rtol)
     try:
@@ -90,7 +90,7 @@ def adhesive_solve(problem, law, gbar, rtol):
 
 def scan(args):
     """Operator applications of the adhesive solve over the reference's, against the peak stress (docstring)."""
-    from roughpetsc.interaction import Dugdale, Exponential
+    from roughpetsc.contact.laws import Dugdale, Exponential
 
     rows = []
     for n in args.n:

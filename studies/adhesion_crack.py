@@ -68,8 +68,8 @@ def paraboloid_surface(grid, kappa_1, kappa_2):
 def run_case(n, sigma, ratio, steps):
     """Rows (p0, b, c, V, pbar, converged) along an opening and closing path of the crack."""
     from roughpetsc import ContactProblem, Grid
-    from roughpetsc.adhesive import AdhesiveContact
-    from roughpetsc.interaction import Dugdale
+    from roughpetsc.contact.adhesive import AdhesiveContact
+    from roughpetsc.contact.laws import Dugdale
 
     kappa_1 = ratio * KAPPA
     work, pressure, length = scales(math.sqrt(kappa_1 * KAPPA))

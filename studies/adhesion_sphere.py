@@ -39,8 +39,8 @@ def work_of(radius_0):
 
 def run_case(n, lam, steps, radius_0):
     from roughpetsc import ContactProblem, Grid
-    from roughpetsc.adhesive import AdhesiveContact, approach_retraction
-    from roughpetsc.interaction import Dugdale
+    from roughpetsc.contact.adhesive import AdhesiveContact, approach_retraction
+    from roughpetsc.contact.laws import Dugdale
 
     work = work_of(radius_0)
     stress = lam / (9 * RADIUS / (2 * math.pi * work * E_STAR ** 2)) ** (1 / 3)

@@ -38,7 +38,7 @@ NAMED = re.compile(r"best (of )?natural residual|time limit|stagnation|round-off
 
 
 def make_law(kind, problem, range_, peak):
-    from roughpetsc.interaction import Dugdale, Exponential
+    from roughpetsc.contact.laws import Dugdale, Exponential
 
     range_ *= problem.sqrt_m0h
     peak *= problem.sqrt_m0p
@@ -72,7 +72,7 @@ def check(grid, heights, law, gbar, pressure, gap, result, rtol):
 
 
 def run_cell(problem, grid, heights, solver, case, rtol, max_time):
-    from roughpetsc.adhesive import AdhesiveContact
+    from roughpetsc.contact.adhesive import AdhesiveContact
 
     kind, range_, peak = CASES[case]
     law = make_law(kind, problem, range_, peak)

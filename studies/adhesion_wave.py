@@ -35,8 +35,7 @@ import os
 import numpy as np
 
 import common
-from roughpetsc.models.wavy_adhesion import (WavyMaugisDugdale, jkr_mean_pressure, jkr_pulloff_displacement_control,
-                                             jkr_pulloff_load_control)
+from roughpetsc.models.wavy_adhesion import WavyMaugisDugdale, jkr_mean_pressure, jkr_pulloff_displacement_control, jkr_pulloff_load_control
 
 AMPLITUDE, WAVELENGTH, E_STAR = 1e-3, 1.0, 1.0
 
@@ -52,9 +51,9 @@ def parameters(alpha, range_over_amplitude):
 def run_case(n, work, stress, steps):
     """The approach-retraction path of one case on 4 x n nodes: a list of dicts (the reason of a stop only)."""
     from roughpetsc import ContactProblem, Grid
-    from roughpetsc.adhesive import AdhesiveContact, approach_retraction
-    from roughpetsc.interaction import Dugdale
-    from roughpetsc.surfaces import wave
+    from roughpetsc.contact.adhesive import AdhesiveContact, approach_retraction
+    from roughpetsc.contact.laws import Dugdale
+    from roughpetsc.surface.generators import wave
 
     grid = Grid(4, n, 4.0 * WAVELENGTH / n, WAVELENGTH)
     problem = ContactProblem(grid, wave(grid, AMPLITUDE, WAVELENGTH), E_STAR)

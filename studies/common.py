@@ -12,7 +12,7 @@ import os
 import sys
 import time
 
-from roughpetsc import presets as preset_files
+from roughpetsc.app import presets as preset_files
 
 ROOT = preset_files.ROOT
 OUTPUT = os.path.join(ROOT, "studies", "output")
@@ -67,8 +67,8 @@ def options_set(options):
     The solvers' scoped manager (``default_options(..., replace=True)``) inserts and removes them; a
     preset option that nothing read by the end of the block stops the study (misspelled?).
     """
-    from roughpetsc.options import unused_options
-    from roughpetsc.solvers.tao_options import default_options
+    from roughpetsc.app.options import unused_options
+    from roughpetsc.solvers.options import default_options
 
     preset = {key: value for key, value in options.items() if key != "kkt_rtol"}
     with default_options(preset, replace=True):

@@ -38,7 +38,7 @@ class Restricted:
     """Operators on the contact set C (indices ``free``): K_CC, and B_C K_CC."""
 
     def __init__(self, problem, free):
-        from roughpetsc.preconditioner import FourierPreconditioner
+        from roughpetsc.solvers.preconditioner import FourierPreconditioner
 
         self.problem = problem
         self.free = free

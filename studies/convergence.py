@@ -38,7 +38,7 @@ def first_reaching(history, level):
 
 def composite_run(problem, options, pstar):
     """PK with the composite-criterion monitor: (iteration where (3.47)+(3.48)+(3.51) hold, natural there)."""
-    from roughpetsc.kkt import CompositeCriterion, report
+    from roughpetsc.contact.certificate import CompositeCriterion, report
 
     scratch = problem.vec()
     target = problem.scaled_pbar(pstar=pstar)

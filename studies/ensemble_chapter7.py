@@ -298,7 +298,7 @@ def table_7_7(ensembles, report):
                "alpha^h dissertation | alpha^p ours (spectral) | alpha^p ours (FD) | alpha^p closed form | alpha^p "
                "dissertation |",
                "|---|---|---|---|---|---|---|---|---|---|"]
-    from roughpetsc import spectra
+    from roughpetsc.surface import spectra
 
     for group in sorted(GROUPS_7):
         for (g, n), e in sorted(ensembles.items()):

@@ -18,7 +18,7 @@ import numpy as np  # noqa: E402
 
 import roughpetsc.models as M  # noqa: E402
 from roughpetsc import ensemble  # noqa: E402
-from roughpetsc.presets import ROOT, fractal_group, fractal_groups  # noqa: E402
+from roughpetsc.app.presets import ROOT, fractal_group, fractal_groups  # noqa: E402
 from roughpetsc.store.ensemble_file import stored_config  # noqa: E402
 
 OUT = os.environ.get("ROUGHPETSC_ENSEMBLE_DIR", os.path.join(ROOT, "studies", "output", "ensembles"))
@@ -155,9 +155,10 @@ def compute_extras():
     petsc4py.init([sys.argv[0]])
     from petsc4py import PETSc
 
-    from roughpetsc.contact import ContactProblem
-    from roughpetsc.control import Solver
-    from roughpetsc.surfaces import Grid, fractal
+    from roughpetsc.contact.problem import ContactProblem
+    from roughpetsc.solvers.facade import Solver
+    from roughpetsc.surface.grid import Grid
+    from roughpetsc.surface.generators import fractal
 
     ensembles = load_ensembles()
     mode = "a" if os.path.exists(EXTRAS) else "w"

@@ -510,7 +510,7 @@ def notes(ensembles, report):
 
 
 def differences(ensembles, report):
-    from roughpetsc.loads import history
+    from roughpetsc.contact.loads import history
 
     all_e = [e for _, e in sorted(ensembles.items())]
     theirs = sorted(set(GROUPS_7) | set(GROUPS_8))

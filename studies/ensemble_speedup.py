@@ -25,14 +25,14 @@ import time
 
 import numpy as np
 
-from roughpetsc.presets import ROOT
+from roughpetsc.app.presets import ROOT
 
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
            "OMPI_MCA_rmaps_base_oversubscribe": "1", "OMPI_MCA_btl_vader_single_copy_mechanism": "none"}
 
 
 def load_argument(text):
-    from roughpetsc import loads
+    from roughpetsc.contact import loads
 
     if text.startswith("history/"):
         step = int(text.split("/", 1)[1])

@@ -93,7 +93,7 @@ def cell_growth():
 
 
 def hertz_stresses(n):
-    from roughpetsc.stresses import free_stresses, max_shear
+    from roughpetsc.elastic.stresses import free_stresses, max_shear
 
     a, load = 1 / 8, 4.0 / 3.0 / 512
     p0 = 3 * load / (2 * np.pi * a ** 2)
@@ -129,7 +129,7 @@ def median_seconds(run, repeat):
 def costs(n, repeat):
     """Time ratios measured in one run: free / periodic, capped / uncapped, stresses per depth in applications."""
     from roughpetsc import ContactProblem, Grid, Solver
-    from roughpetsc.stresses import free_stresses, periodic_stresses
+    from roughpetsc.elastic.stresses import free_stresses, periodic_stresses
 
     grid = Grid(n, n)
     heights = common.group1_heights(grid)
@@ -194,7 +194,7 @@ def operator_seconds(grid, heights, boundary, repeat):
 def transform_floor(shape, counts, repeat):
     """Median seconds of ``counts = (forward, inverse)`` bare transforms on ``shape``: what the stresses of
     one depth cannot do without (the FFTW plans of :mod:`roughpetsc.stresses`, from the solves' wisdom)."""
-    from roughpetsc.stresses import fft_pair
+    from roughpetsc.elastic.stresses import fft_pair
 
     real, spectrum, forward, backward = fft_pair(shape, "FFTW_MEASURE")
     real[...] = 1.0

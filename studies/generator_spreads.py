@@ -40,7 +40,7 @@ MOMENTS = ("m20", "m02", "m40", "m04", "m60", "m06")
 
 def moments(heights, spacing, interior):
     """The six directional FD moments of one surface (periodic differences, or interior nodes only)."""
-    from roughpetsc.spectra import fd_derivative
+    from roughpetsc.surface.spectra import fd_derivative
 
     values = {}
     for axis, direction in ((1, "x"), (0, "y")):

@@ -79,10 +79,11 @@ def stages(N, folder):
     tracemalloc.start()
     from petsc4py import PETSc
 
-    from roughpetsc import ContactProblem, Grid, Solver, fractal, fractal_group, surface_moments
-    from roughpetsc.slab import gather_rows
-    from roughpetsc.store import load_path
-    from roughpetsc.surfaces import validate
+    from roughpetsc import ContactProblem, Grid, Solver, fractal, fractal_group
+    from roughpetsc.surface import moments as surface_moments
+    from roughpetsc.parallel import gather_rows
+    from roughpetsc.store import path_file as load_path
+    from roughpetsc.surface.files import validate
 
     comm = PETSc.COMM_WORLD.tompi4py()
     grid = Grid(N, N, 1.0, 1.0)

@@ -90,7 +90,7 @@ def _transform(name):
     ``current``: as roughpetsc.westergaard is; ``mpi4py-fft``: :class:`PfftTransform`, swapped in for
     roughpetsc.slab.SlabTransform, which westergaard imports when it builds one.
     """
-    from roughpetsc import slab
+    from roughpetsc.fft import slab
 
     if name == "current":
         yield
@@ -154,7 +154,7 @@ class _Pair:
                 fft.backward(spectrum, real, normalize=False)
             self._destroy.append(fft.destroy)
         elif name.startswith("slab/"):
-            from roughpetsc.slab import SlabTransform
+            from roughpetsc.fft.slab import SlabTransform
 
             transform = SlabTransform(grid, comm, "FFTW_MEASURE", name.split("/")[1])
             real = pyfftw.empty_aligned(transform.real.shape, dtype="float64")
@@ -165,7 +165,7 @@ class _Pair:
                 transform.backward(real)
             self._destroy.append(transform.destroy)
         elif name in ("shell", "shell/mpi4py-fft"):
-            from roughpetsc import westergaard
+            from roughpetsc.elastic import westergaard
 
             with _transform("current" if name == "shell" else "mpi4py-fft"):
                 operator = westergaard.Westergaard(grid, 1.0, PETSc.COMM_WORLD)

@@ -52,8 +52,8 @@ def main():
     common.init()
     import peers
     from roughpetsc import ContactProblem, Grid
-    from roughpetsc.adhesive import AdhesiveContact
-    from roughpetsc.interaction import Dugdale, Exponential
+    from roughpetsc.contact.adhesive import AdhesiveContact
+    from roughpetsc.contact.laws import Dugdale, Exponential
 
     rows = []
     with tempfile.TemporaryDirectory() as workdir:

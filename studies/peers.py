@@ -41,8 +41,8 @@ import numpy as np  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
 from roughpetsc import ContactProblem, Grid, Solver, fractal, fractal_group  # noqa: E402
-from roughpetsc.contact import measure  # noqa: E402
-from roughpetsc.kkt import report  # noqa: E402
+from roughpetsc.contact.result import measure  # noqa: E402
+from roughpetsc.contact.certificate import report  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PEER_PYTHON = os.path.join(ROOT, ".peers-venv", "bin", "python")

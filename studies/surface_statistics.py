@@ -21,8 +21,11 @@ import time
 
 import numpy as np
 
-from roughpetsc import Grid, fractal, fractal_amplitude, spectra, stats_mode, stats_output
-from roughpetsc.presets import fractal_groups
+from roughpetsc import Grid, fractal, fractal_amplitude
+from roughpetsc.surface import spectra
+from roughpetsc.app import stats_mode, stats_output
+from roughpetsc.app.presets import fractal_groups
+from roughpetsc.store.outputs import write_json
 
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "output", "statistics")
 
@@ -122,7 +125,7 @@ def compute_all(realisations, realisations_2048, groups, generator, cache, note)
         results[str(group)] = group_statistics(group, count, edges, generator)
         results[str(group)]["seconds"] = time.time() - start
         stored["elapsed"] += time.time() - start
-        stats_output.write_json(cache, stored)
+        write_json(cache, stored)
         print(f"group {group}: {count} realisations in {time.time() - start:.1f} s", flush=True)
     return {str(g): results[str(g)] for g in groups}, stored["elapsed"]
 

@@ -42,7 +42,7 @@ from scipy.stats import norm
 from ensemble_common import DISSERTATION_TABLE_8_4_MEANS as PRINTED_MEANS, OUT as ENSEMBLES, TOLERANCE, \
     dissertation_grid, grid_effects, load_ensembles, plt
 from grid_convergence import load_rows as grid_convergence_rows, richardson
-from roughpetsc.loads import history
+from roughpetsc.contact.loads import history
 from roughpetsc.models import ALPHA_P_TABLE_8_3, BGT_SLOPE, TABLE_8_4, bootstrap_curvefit, correction, \
     curvefit_area, curvefit_reference, curvefit_slope_at_zero, fit_curvefit, persson_area
 from surface_statistics import SEED_8_2

@@ -64,10 +64,10 @@ def applications_at_time_limit(monkeypatch, problem):
 
     ``problem.operator.applications`` minus its one entry is then the work done after the limit.
     """
-    from roughpetsc import kkt
+    from roughpetsc.solvers import stopping
 
     at_limit = []
-    out_of_time = kkt.History.out_of_time
+    out_of_time = stopping.History.out_of_time
 
     def recorded(history, max_seconds):
         expired = out_of_time(history, max_seconds)
@@ -75,5 +75,5 @@ def applications_at_time_limit(monkeypatch, problem):
             at_limit.append(problem.operator.applications)
         return expired
 
-    monkeypatch.setattr(kkt.History, "out_of_time", recorded)
+    monkeypatch.setattr(stopping.History, "out_of_time", recorded)
     return at_limit

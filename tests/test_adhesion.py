@@ -19,11 +19,12 @@ import pytest
 import h5py
 
 from conftest import MPI_ENV, ROOT, applications_at_time_limit, run_cli
-from roughpetsc.adhesive import AdhesiveContact, approach_retraction, dissipated_energy
-from roughpetsc.contact import ContactProblem
+from roughpetsc.contact.adhesive import AdhesiveContact, approach_retraction, dissipated_energy
+from roughpetsc.contact.problem import ContactProblem
 from roughpetsc.errors import ParameterError
-from roughpetsc.interaction import Dugdale, Exponential, make_law
-from roughpetsc.surfaces import Grid, fractal
+from roughpetsc.contact.laws import Dugdale, Exponential, make_law
+from roughpetsc.surface.grid import Grid
+from roughpetsc.surface.generators import fractal
 
 RADIUS = 1.0
 
@@ -140,10 +141,11 @@ import numpy as np
 import petsc4py
 petsc4py.init()
 from petsc4py import PETSc
-from roughpetsc.adhesive import AdhesiveContact
-from roughpetsc.contact import ContactProblem
-from roughpetsc.interaction import Exponential
-from roughpetsc.surfaces import Grid, fractal
+from roughpetsc.contact.adhesive import AdhesiveContact
+from roughpetsc.contact.problem import ContactProblem
+from roughpetsc.contact.laws import Exponential
+from roughpetsc.surface.grid import Grid
+from roughpetsc.surface.generators import fractal
 grid = Grid(45, 32, 1.0, 1.0)
 heights = fractal(grid, 2, 10, 0.8, 1e-2, seed=5)
 problem = ContactProblem(grid, heights, 1.0, fft_effort="FFTW_ESTIMATE")
@@ -251,7 +253,7 @@ def test_tao_almm_meets_the_gap_cg():
 def dugdale_wave_path(n, alpha, range_over_amplitude, steps=40):
     """Approach and retraction of Johnson's wave (lambda = 1, h = 1e-3, E* = 1) with the Dugdale law on n nodes,
     ``steps`` each way."""
-    from roughpetsc.surfaces import wave
+    from roughpetsc.surface.generators import wave
 
     amplitude = 1e-3
     work = alpha ** 2 * math.pi ** 2 * amplitude ** 2 / 2  # Johnson's alpha = sqrt(2 lambda w / (pi^2 E* h^2))
@@ -330,7 +332,7 @@ def test_penny_shaped_adhesive_crack_meets_the_maugis_dugdale_crack():
     order; studies/adhesion_crack.py gives the grid sequence), median volume error 3.7 % and 2.4 %.
     """
     from roughpetsc.models.adhesion import AdhesiveCrack
-    from roughpetsc.spectra import heights_from_pressure_surface
+    from roughpetsc.surface.spectra import heights_from_pressure_surface
 
     n, sigma, length = 384, 1.0, 16.0 / 384
     work = 16 * length ** 5 / (81 * math.pi)

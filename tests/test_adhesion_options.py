@@ -46,7 +46,7 @@ def test_energy_change_at_extreme_ranges_is_exact_and_quiet():
 
     import mpmath
 
-    from roughpetsc.interaction import Exponential
+    from roughpetsc.contact.laws import Exponential
 
     mpmath.mp.dps = 40
     for work, range_ in ((2.0, 0.3), (2e-7, 1e-9), (1e-3, 1e-12)):
@@ -88,8 +88,8 @@ def test_an_adhesive_plot_draws_pbar_against_the_mean_gap(tmp_path, monkeypatch)
         return save(figure, *args, **kwargs)
 
     monkeypatch.setattr(Figure, "savefig", keep)
-    from roughpetsc import plots
-    from roughpetsc.surfaces import Grid
+    from roughpetsc.app import plots
+    from roughpetsc.surface.grid import Grid
 
     gaps = [1e-3, 5e-4, 2e-4, 5e-4, 1e-3]
     pbars = [1e-4, 1e-3, 3e-3, 8e-4, -2e-5]

@@ -49,7 +49,7 @@ def test_every_export_resolves():
 
 def test_fractal_group_one_is_the_embedded_default():
     from roughpetsc import fractal_group
-    from roughpetsc.surfaces import SURFACE_OPTIONS
+    from roughpetsc.app.surface_options import SURFACE_OPTIONS
 
     defaults = {name: default for name, default, _ in SURFACE_OPTIONS}
     # The embedded default surface has group 1's PSD; the group presets take the dissertation's generator.
@@ -73,7 +73,7 @@ def test_bad_parameters_are_named_physically():
 def test_unused_options_are_listed_or_the_reason_given(monkeypatch):
     from petsc4py import PETSc
 
-    from roughpetsc import options
+    from roughpetsc.app import options
 
     PETSc.Options().setValue("roughpetsc_never_read", "1")
     try:

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from roughpetsc import asperities, spectra
-from roughpetsc.surfaces import Grid, bisinusoid, fractal
+from roughpetsc.surface import summits as asperities, spectra
+from roughpetsc.surface.grid import Grid
+from roughpetsc.surface.generators import bisinusoid, fractal
 
 # --- summits of deterministic fields ------------------------------------------------
 

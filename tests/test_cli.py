@@ -170,7 +170,7 @@ def test_time_limit_is_reported_as_not_converged(tmp_path, ranks, args):
 
 
 def test_every_mode_is_one_module_with_an_option_table_and_run():
-    from roughpetsc import cli
+    from roughpetsc.app import cli
 
     assert list(cli.MODES) == ["solve", "stats", "models", "ensemble"]
     for module in cli.MODES.values():
@@ -180,7 +180,7 @@ def test_every_mode_is_one_module_with_an_option_table_and_run():
 
 def test_a_library_error_is_reported_by_the_option_that_set_its_parameter():
     from roughpetsc.errors import ParameterError, UserError
-    from roughpetsc.mode_settings import options_named, user_message
+    from roughpetsc.app.settings import options_named, user_message
 
     assert user_message(ParameterError("k_s", "exceeds the Nyquist wavenumber")) == \
         "-surface_ks: exceeds the Nyquist wavenumber"

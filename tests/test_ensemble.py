@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from conftest import MPI_ENV, ROOT, run_cli
-from roughpetsc import ensemble, loads
+from roughpetsc import ensemble
+from roughpetsc.contact import loads
 from roughpetsc.errors import UserError
 
 SMALL = ["-mode", "ensemble", "-surface_N", 64, "-surface_kl", 4, "-surface_ks", 16, "-ensemble_seed", 7,

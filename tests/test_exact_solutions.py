@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from roughpetsc.contact import ContactProblem
-from roughpetsc.control import Solver
-from roughpetsc.surfaces import Grid, bisinusoid, wave
+from roughpetsc.contact.problem import ContactProblem
+from roughpetsc.solvers.facade import Solver
+from roughpetsc.surface.grid import Grid
+from roughpetsc.surface.generators import bisinusoid, wave
 
 E_STAR = 2.5
 AMPLITUDE = 0.01

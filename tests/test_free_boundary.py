@@ -10,10 +10,11 @@ import pytest
 from petsc4py import PETSc
 
 from conftest import run_cli
-from roughpetsc.contact import ContactProblem
-from roughpetsc.love import FreeBoundary, direct_displacement
+from roughpetsc.contact.problem import ContactProblem
+from roughpetsc.elastic.love import FreeBoundary, direct_displacement
 from roughpetsc.solvers import Solver
-from roughpetsc.surfaces import Grid, hertz_sphere
+from roughpetsc.surface.grid import Grid
+from roughpetsc.surface.generators import hertz_sphere
 
 
 def apply(operator, field):

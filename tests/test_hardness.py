@@ -11,9 +11,10 @@ import pytest
 from scipy.optimize import minimize
 
 from conftest import run_cli
-from roughpetsc.contact import ContactProblem
+from roughpetsc.contact.problem import ContactProblem
 from roughpetsc.solvers import Solver
-from roughpetsc.surfaces import Grid, fractal, wave
+from roughpetsc.surface.grid import Grid
+from roughpetsc.surface.generators import fractal, wave
 
 N = 24
 

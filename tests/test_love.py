@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from roughpetsc.love import direct_displacement, influence, padded_symbol
+from roughpetsc.elastic.love import direct_displacement, influence, padded_symbol
 
 
 def dissertation_form(R, S, dx, dy):

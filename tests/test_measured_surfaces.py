@@ -9,7 +9,7 @@ import pytest
 
 from conftest import run_cli
 from roughpetsc import ContactProblem, Grid, ParameterError, Westergaard, fractal, fractal_amplitude, load_surface
-from roughpetsc import spectra, surfaces
+from roughpetsc.surface import files, generators, spectra
 from test_newcomer import assert_one_clear_error
 
 GRID = Grid(32, 32)
@@ -87,12 +87,12 @@ def tilted(heights, slope_x, slope_y):
 
 def test_detrend_plane_recovers_the_periodic_surface_and_reports_the_plane():
     heights = periodic_heights()
-    levelled, levelling = surfaces.level(GRID, tilted(heights, 3e-3, -1e-3), "plane")
+    levelled, levelling = files.level(GRID, tilted(heights, 3e-3, -1e-3), "plane")
     # The removed plane is the tilt plus the periodic surface's own best-fit plane (least squares is linear).
-    _, own_x, own_y = surfaces.fit_plane(GRID, heights)
+    _, own_x, own_y = files.fit_plane(GRID, heights)
     assert levelling.slope_x == pytest.approx(3e-3 + own_x, rel=1e-10)
     assert levelling.slope_y == pytest.approx(-1e-3 + own_y, rel=1e-10)
-    expected = heights - surfaces.plane_heights(GRID, own_x, own_y)
+    expected = heights - files.plane_heights(GRID, own_x, own_y)
     assert np.allclose(levelled, expected - expected.mean(), rtol=0, atol=1e-17)
     assert levelling.removed and levelling.notes[0].startswith("-surface_detrend plane removed the plane")
     assert not any("tilted" in note for note in levelling.notes)
@@ -102,17 +102,17 @@ def test_detrend_plane_recovers_the_periodic_surface_and_reports_the_plane():
 def test_a_periodic_surface_gets_no_warning(k_l, k_s, n):
     grid = Grid(n, n)
     for seed in range(1, 11):
-        _, levelling = surfaces.level(grid, fractal(grid, k_l, k_s, 0.8, 2e-4, seed=seed), "mean")
+        _, levelling = files.level(grid, fractal(grid, k_l, k_s, 0.8, 2e-4, seed=seed), "mean")
         assert levelling.notes == ()
 
 
 def test_tilt_and_edge_jumps_are_warned_of_with_the_figures():
-    _, levelling = surfaces.level(GRID, tilted(periodic_heights(), 3e-3, 0.0), "mean")
+    _, levelling = files.level(GRID, tilted(periodic_heights(), 3e-3, 0.0), "mean")
     warnings = [note for note in levelling.notes if note.startswith("warning")]
     assert any("tilted" in note and "-surface_detrend plane" in note for note in warnings)
     assert any("not periodic" in note and "along x" in note for note in warnings)
     cropped = fractal(Grid(256, 256), 2, 16, 0.8, 2e-4, seed=5)[:64, :64]  # a window of a larger surface
-    _, levelling = surfaces.level(Grid(64, 64), cropped, "plane")
+    _, levelling = files.level(Grid(64, 64), cropped, "plane")
     assert any("not periodic" in note and "along x" in note for note in levelling.notes)
     assert any("not periodic" in note and "along y" in note for note in levelling.notes)
 
@@ -190,10 +190,10 @@ def test_a_wavelength_that_does_not_divide_the_cell_is_refused(tmp_path, kind, w
 
 def test_wavelengths_that_divide_the_cell_are_used():
     grid = Grid(16, 64, 0.25, 1.0)
-    assert surfaces.wave(grid, 1e-3, 0.25).shape == (16, 64)
-    assert surfaces.bisinusoid(grid, 1e-3, 0.125, 1.0 / 3).shape == (16, 64)
+    assert generators.wave(grid, 1e-3, 0.25).shape == (16, 64)
+    assert generators.bisinusoid(grid, 1e-3, 0.125, 1.0 / 3).shape == (16, 64)
     with pytest.raises(ParameterError, match="does not divide"):
-        surfaces.bisinusoid(grid, 1e-3, 0.1, 0.25)
+        generators.bisinusoid(grid, 1e-3, 0.1, 0.25)
 
 
 # --- the Python API validates at construction ---------------------------------------------------------------

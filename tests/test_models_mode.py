@@ -9,7 +9,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from roughpetsc.errors import UserError
-from roughpetsc.models import ALPHA_P_TABLE_8_3, TABLE_8_4, complete, correction, early, mode
+from roughpetsc.models import ALPHA_P_TABLE_8_3, TABLE_8_4, complete, correction, early
+from roughpetsc.app import models_mode as mode
 
 from conftest import run_cli
 import dissertation_formulas as reference_formulas

@@ -173,8 +173,8 @@ def test_the_shell_hessian_takes_tao_shifts():
     import numpy as np
     from petsc4py import PETSc
 
-    from roughpetsc.surfaces import Grid
-    from roughpetsc.westergaard import Westergaard
+    from roughpetsc.surface.grid import Grid
+    from roughpetsc.elastic.westergaard import Westergaard
 
     operator = Westergaard(Grid(16, 16, 1.0, 1.0), 1.0, PETSc.COMM_SELF, effort="FFTW_ESTIMATE")
     mat = operator.mat()

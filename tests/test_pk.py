@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from roughpetsc.contact import ContactProblem
-from roughpetsc.control import Solver
-from roughpetsc.surfaces import Grid, fractal
+from roughpetsc.contact.problem import ContactProblem
+from roughpetsc.solvers.facade import Solver
+from roughpetsc.surface.grid import Grid
+from roughpetsc.surface.generators import fractal
 
 
 @pytest.fixture(scope="module")
@@ -88,7 +89,7 @@ def test_unknown_choice_is_a_user_error_naming_its_option(problem, option, value
 
 def test_fourier_preconditioner_is_symmetric_positive_definite_on_a_free_set():
     """The free-set matrix TAO's PC "mat" applies: assembled column by column on a 16^2 grid."""
-    from roughpetsc.preconditioner import FourierPreconditioner
+    from roughpetsc.solvers.preconditioner import FourierPreconditioner
 
     grid = Grid(16, 16)
     small = ContactProblem(grid, fractal(grid, 2, 8, 0.8, 2e-4, 5), 1.0, PETSc.COMM_SELF,

@@ -3,10 +3,11 @@
 import pytest
 from petsc4py import PETSc
 
-from roughpetsc.contact import ContactProblem
+from roughpetsc.contact.problem import ContactProblem
 from roughpetsc.errors import ParameterError
 from roughpetsc.solvers import Solver, backend_names, load_path, make_backend, register, unregister
-from roughpetsc.surfaces import Grid, fractal
+from roughpetsc.surface.grid import Grid
+from roughpetsc.surface.generators import fractal
 
 LOADS = [0.05, 0.2, 0.5, 1.0]
 

@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 
 from roughpetsc.errors import ParameterError
-from roughpetsc.slab import SlabTransform, block_split, row_split
-from roughpetsc.surfaces import Grid
+from roughpetsc.fft.slab import SlabTransform
+from roughpetsc.parallel import block_split, row_split
+from roughpetsc.surface.grid import Grid
 
 from conftest import MPI_ENV, ROOT
 
@@ -27,9 +28,10 @@ petsc4py.init(sys.argv[:1])
 import pyfftw
 from mpi4py import MPI
 from petsc4py import PETSc
-from roughpetsc.slab import SlabTransform, row_split
-from roughpetsc.surfaces import Grid
-from roughpetsc.westergaard import Westergaard
+from roughpetsc.fft.slab import SlabTransform
+from roughpetsc.parallel import row_split
+from roughpetsc.surface.grid import Grid
+from roughpetsc.elastic.westergaard import Westergaard
 
 world = MPI.COMM_WORLD
 size, rank = world.Get_size(), world.Get_rank()

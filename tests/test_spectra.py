@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from roughpetsc import spectra
-from roughpetsc.surfaces import Grid, bisinusoid, fractal, fractal_amplitude, fractal_psd
+from roughpetsc.surface import spectra
+from roughpetsc.surface.grid import Grid
+from roughpetsc.surface.generators import bisinusoid, fractal, fractal_amplitude, fractal_psd
 
 ORDERS = (0, 2, 4, 6)
 
@@ -288,7 +289,8 @@ def test_table_8_groups_bandwidths(k_l, k_s, hurst, n, seeds, alpha_h_seed, alph
 def test_xu_generator_has_the_prescribed_amplitude_in_every_realisation():
     """(7.2)-(7.5): |F[h]| = sqrt(S(k) n0 n1 / A0) for every seed, so the spectral moments do not vary;
     the filter's amplitudes are random, with the same expected moments."""
-    from roughpetsc.surfaces import Grid, fractal, fractal_amplitude, fractal_psd
+    from roughpetsc.surface.grid import Grid
+    from roughpetsc.surface.generators import fractal, fractal_amplitude, fractal_psd
 
     grid = Grid(128, 128)
     k0, k1 = grid.rfft_wavenumbers()
@@ -313,8 +315,8 @@ def test_xu_generator_has_the_prescribed_amplitude_in_every_realisation():
 
 
 def test_heights_from_pressure_surface_inverts_the_pressure_surface():
-    from roughpetsc.spectra import heights_from_pressure_surface, pressure_surface
-    from roughpetsc.surfaces import Grid
+    from roughpetsc.surface.spectra import heights_from_pressure_surface, pressure_surface
+    from roughpetsc.surface.grid import Grid
 
     grid = Grid(32, 48, 1.0, 1.5)
     target = np.random.default_rng(3).standard_normal(grid.shape)

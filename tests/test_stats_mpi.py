@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from conftest import run_cli
-from roughpetsc import ensemble, seeds
+from roughpetsc import ensemble
+from roughpetsc.surface import seeds
 from roughpetsc.store import stats_file
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -20,7 +21,7 @@ import sys, petsc4py
 petsc4py.init(sys.argv)
 from petsc4py import PETSc
 from mpi4py import MPI
-from roughpetsc import stats_mode
+from roughpetsc.app import stats_mode
 from roughpetsc.errors import UserError
 try:
     stats_mode.run(PETSc.Options(), MPI.COMM_WORLD)
@@ -63,8 +64,9 @@ def test_ensemble_on_two_ranks_equals_one_rank(tmp_path):
 
 
 def test_single_surface_on_two_ranks_equals_python_api(tmp_path):
-    from roughpetsc import spectra
-    from roughpetsc.surfaces import Grid, fractal
+    from roughpetsc.surface import spectra
+    from roughpetsc.surface.grid import Grid
+    from roughpetsc.surface.generators import fractal
 
     two, _ = stats_json(2, SMALL_GROUP, tmp_path)
     grid = Grid(128, 128, 1.0, 1.0)
@@ -153,7 +155,7 @@ import sys, petsc4py
 petsc4py.init(sys.argv)
 from petsc4py import PETSc
 from mpi4py import MPI
-from roughpetsc import stats_mode
+from roughpetsc.app import stats_mode
 from roughpetsc.errors import ParameterError, UserError
 
 compute_one = stats_mode.surface_statistics

@@ -4,8 +4,7 @@ import numpy as np
 import pytest
 
 from roughpetsc.errors import ParameterError
-from roughpetsc.stresses import (element_influence, free_stresses, max_shear, padded_influence, periodic_stresses,
-                                 von_mises)
+from roughpetsc.elastic.stresses import element_influence, free_stresses, max_shear, padded_influence, periodic_stresses, von_mises
 
 
 def rotated_plane_strain(amplitude, wavenumber, direction, depth, nu, phase):

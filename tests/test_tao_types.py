@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from roughpetsc.contact import ContactProblem
-from roughpetsc.control import Solver
-from roughpetsc.surfaces import Grid, fractal
+from roughpetsc.contact.problem import ContactProblem
+from roughpetsc.solvers.facade import Solver
+from roughpetsc.surface.grid import Grid
+from roughpetsc.surface.generators import fractal
 
 from conftest import applications_at_time_limit
 

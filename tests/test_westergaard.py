@@ -3,8 +3,8 @@
 import numpy as np
 from petsc4py import PETSc
 
-from roughpetsc.surfaces import Grid
-from roughpetsc.westergaard import Westergaard
+from roughpetsc.surface.grid import Grid
+from roughpetsc.elastic.westergaard import Westergaard
 
 
 def reference_displacement(grid, pressure, E_star):

@@ -18,7 +18,7 @@ ends with the same numbers as an uninterrupted one (wall times, run numbers and 
 :data:`VOLATILE`).
 """
 
-from ..seeds import surface_seed
+from ..surface.seeds import surface_seed
 from ..store import read
 from ..store.ensemble_file import FORMAT, STEP_FIELDS, SURFACE_FIELDS, VOLATILE, compare
 from .runner import run

@@ -18,11 +18,11 @@ import traceback
 
 import numpy as np
 
-from .. import io
+from ..store import outputs as io
 from ..errors import UserError
-from ..seeds import RULE as SEED_RULE, surface_seed
+from ..surface.seeds import RULE as SEED_RULE, surface_seed
 from ..store import ensemble_file
-from ..surface_moments import surface_moments
+from ..surface.moments import surface_moments
 from . import settings as ensemble_settings
 from .scheduler import IDLE_SLEEP, TAG_NEXT, TAG_RECORD, WorkCounter
 from .statistics import compute_models, step_statistics
@@ -36,9 +36,10 @@ def probe_solver(s):
     """
     from petsc4py import PETSc
 
-    from ..contact import ContactProblem
-    from ..control import Solver
-    from ..surfaces import Grid, wave
+    from ..contact.problem import ContactProblem
+    from ..solvers.facade import Solver
+    from ..surface.grid import Grid
+    from ..surface.generators import wave
 
     grid = Grid(2, 8, 0.25, 1.0)
     problem = ContactProblem(grid, wave(grid, 1.0, 1.0), s.E_star, PETSc.COMM_SELF, 1, "FFTW_ESTIMATE")
@@ -66,8 +67,8 @@ def share_fftw_wisdom(comm, group, s, stored):
     import pyfftw
     from petsc4py import PETSc
 
-    from ..contact import ContactProblem
-    from ..surfaces import wave
+    from ..contact.problem import ContactProblem
+    from ..surface.generators import wave
 
     stored = comm.bcast(stored, root=0)
     if stored:
@@ -96,12 +97,12 @@ def solve_surface(reader, s, index, seed, group, run_id, between_steps):
     """
     from petsc4py import PETSc
 
-    from .. import surfaces
-    from ..contact import ContactProblem
-    from ..control import Solver
+    from ..app import surface_options
+    from ..contact.problem import ContactProblem
+    from ..solvers.facade import Solver
 
     start = time.perf_counter()
-    grid, heights = surfaces.from_options(reader, seed=seed)
+    grid, heights = surface_options.from_options(reader, seed=seed)
     problem = ContactProblem(grid, heights, s.E_star, PETSc.Comm(group), s.threads, s.effort)
     solver = None
     try:
@@ -318,7 +319,7 @@ class Ensemble:
 
 def run(reader, comm):
     """Entry point of ``python -m roughpetsc -mode ensemble``; returns the exit status (0, or 3 if a step failed)."""
-    from ..options import check_unused
+    from ..app.options import check_unused
 
     s = ensemble_settings.read_settings(reader, comm.Get_size())
     solver_name = probe_solver(s)

@@ -3,11 +3,13 @@
 from dataclasses import dataclass
 import json
 
-from .. import loads, mode_settings, seeds
+from ..contact import loads
+from ..app import settings as mode_settings
+from ..surface import seeds
 from ..errors import UserError
-from ..io import check_writable
-from ..mode_settings import Option
-from ..slab import row_split
+from ..store.outputs import check_writable
+from ..app.settings import Option
+from ..parallel import row_split
 from .statistics import MODEL_NAMES
 
 OPTIONS = [

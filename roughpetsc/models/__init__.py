@@ -28,12 +28,9 @@ sphere_adhesion, wavy_adhesion
 """
 
 from . import crack, hertz, pdfs, quadrature, sphere_adhesion, wavy_adhesion
-from .adhesion import (AdhesiveCrack, AdhesiveGW, jkr_G, jkr_pmin, jkr_pstar,
-                       jkr_radius, jkr_volume, nonadhesive_area,
-                       nonadhesive_radius, nonadhesive_volume)
+from .adhesion import AdhesiveCrack, AdhesiveGW, jkr_G, jkr_pmin, jkr_pstar, jkr_radius, jkr_volume, nonadhesive_area, nonadhesive_radius, nonadhesive_volume
 from .complete import COMPLETE_MODELS, complete
-from .curvefit import (ALPHA_P_TABLE_8_3, BGT_SLOPE, CURVEFIT_MODEL, TABLE_8_4, bootstrap_curvefit, correction,
-                       curvefit_area, curvefit_reference, curvefit_slope_at_zero, fit_curvefit)
+from .curvefit import ALPHA_P_TABLE_8_3, BGT_SLOPE, CURVEFIT_MODEL, TABLE_8_4, bootstrap_curvefit, correction, curvefit_area, curvefit_reference, curvefit_slope_at_zero, fit_curvefit
 from .early import EARLY_MODELS, TABLE_4_1, TABLE_4_1_SEPARATIONS, early, early_area, early_separation
 from .persson import fractal_moments, persson_area, persson_gap, psd_amplitude
 

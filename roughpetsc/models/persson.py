@@ -7,8 +7,8 @@
 import numpy as np
 from scipy.special import erf, exp1
 
-from ..spectra import fractal_height_moment
-from ..surfaces import fractal_amplitude as psd_amplitude
+from ..surface.spectra import fractal_height_moment
+from ..surface.generators import fractal_amplitude as psd_amplitude
 from .quadrature import gauss_legendre
 
 __all__ = ["persson_area", "persson_gap", "psd_amplitude", "fractal_moments"]

@@ -1,26 +1,31 @@
-"""Solvers of the contact QP (3.41)-(3.44) of the dissertation, under load and displacement control.
+"""The solver layer: one facade, one stopping rule, one load-path driver, backends registered by name.
 
 One concept per module:
 
-- :mod:`.protocol`: what a backend offers (``solve(target, pressure, guess) -> Outcome``, ``destroy``,
-  ``name``, ``tao``, optional ``keeps_displacement``);
-- :mod:`.registry`: backends by name (``register``, ``unregister``, ``backend_names``, ``make_backend``);
+- :mod:`.protocol`: what a problem offers the solvers, and what a backend offers the facade
+  (``solve(target, unknown, guess) -> Outcome``, ``destroy``, ``name``, ``tao``);
+- :mod:`.registry`: backends by problem kind, name and control (``register``, ``backend_names``,
+  ``make_backend``), with the option table each declares;
+- :mod:`.stopping`: the stopping rule of every backend (tolerance, fresh confirmation, limits, stagnation,
+  best iterate) and the TAO convergence test that carries it;
+- :mod:`.options`: the per-solver options manager (options pushed under a prefix, removed at the end),
+  scoped defaults, ``setFromOptions`` with a clear error, the TAO ``python`` type;
+- :mod:`.facade` (the :class:`Solver`), :mod:`.load_path` (:func:`drive` and the generator :func:`load_path`);
 - backends, each registering itself in one line: :mod:`.pk` (Polonsky-Keer, the TAO python context in
   :mod:`.polonsky_keer`), :mod:`.bound_qp` (any bound-constrained TAO type, displacement control),
-  :mod:`.root_find` (load control by a root find on the separation around it), :mod:`.almm` (TAO ALMM);
-- :mod:`.objective` (the QP's objective for TAO), :mod:`.tao_options` (options prefix, scoped
-  defaults, the time limit);
-- :mod:`.solver` (the :class:`Solver` facade), :mod:`.continuation` (warm starts along loads),
-  :mod:`.load_path` (a generator of results along loads).
+  :mod:`.root_find` (load control by a root find on the separation around it), :mod:`.almm` (TAO ALMM),
+  :mod:`.gap_cg` and :mod:`.adhesive_almm` (the adhesive problem);
+- :mod:`.objective` (the QP's objective for TAO), :mod:`.preconditioner` (the Fourier preconditioner).
 
 A new solver or physics adds one module that registers its factory and one import line here.
 """
 
 from .protocol import Backend, BackendSettings, Guess, Outcome
-from .registry import backend_names, make_backend, register, unregister
-from . import pk, bound_qp, root_find, almm  # noqa: F401  (each registers its backend)
-from .solver import Solver
-from .load_path import load_path
+from .registry import backend_names, make_backend, option_tables, register, unregister
+from . import pk, bound_qp, root_find, almm, gap_cg, adhesive_almm  # noqa: F401  (each registers its backend)
+from .facade import Solver
+from .load_path import drive, load_path
+from .stopping import StoppingRule
 
-__all__ = ["Backend", "BackendSettings", "Guess", "Outcome", "Solver", "backend_names", "load_path", "make_backend",
-           "register", "unregister"]
+__all__ = ["Backend", "BackendSettings", "Guess", "Outcome", "Solver", "StoppingRule", "backend_names", "drive",
+           "load_path", "make_backend", "option_tables", "register", "unregister"]

@@ -6,11 +6,12 @@ Registered as ``almm`` for load control only.
 import numpy as np
 from petsc4py import PETSc
 
-from ..kkt import ConvergenceTest, History
+from ..contact.certificate import report
 from .objective import QuadraticObjective
-from .protocol import Backend, Outcome, describe_stop
+from .options import default_options, set_from_options, stop_subsolver
+from .protocol import Backend, Outcome
 from .registry import register
-from .tao_options import DEFAULT_MAX_IT, set_from_options, stop_subsolver
+from .stopping import DEFAULT_MAX_IT, ConvergenceTest, History, describe_stop
 
 
 def mean_jacobian(constraint, vec, n, comm):
@@ -27,7 +28,94 @@ def mean_jacobian(constraint, vec, n, comm):
     return jacobian
 
 
-class ALMMLoad(Backend):
+class MeanConstrainedALMM(Backend):
+    """TAO ALMM on ``unknown >= 0`` (``<= upper``) with the one equality ``mean(unknown) = target``.
+
+    What the ALMM backends of both problem kinds share: the bounds, the equality and its Jacobian, the
+    time limit inside the subsolver, the convergence test of the stopping rule on the outer iterations.
+    A subclass makes its own objects, then calls ``__init__``, and supplies :meth:`evaluate` (objective
+    and gradient), :meth:`natural_residual` (the test's ``(natural, error of the equality, fresh)``),
+    :meth:`prepare` (before a solve) and :meth:`finish` (after it; returns the Outcome's separation).
+
+    Parameters
+    ----------
+    problem :
+        The problem (its layout and comm).
+    settings : BackendSettings
+    upper : float or None
+        The upper bound of every entry (None: none).
+    hessian : petsc4py.PETSc.Mat or None
+        The Hessian TAO may use (None: none given).
+    defaults : dict
+        Working defaults of TAO options, unless given (:func:`~roughpetsc.solvers.options.default_options`).
+    """
+
+    name = "almm"
+
+    def __init__(self, problem, settings, upper=None, hessian=None, defaults=None):
+        self.problem = problem
+        self.rule = settings.rule
+        self.target = 0.0
+        self.history = None
+        self.watch = None
+        comm = problem.comm
+        self.gradient = problem.vec()
+        self.lower = problem.vec()
+        self.lower.set(0.0)
+        self.upper = problem.vec()
+        self.upper.set(PETSc.INFINITY if upper is None else upper)
+        self.constraint = PETSc.Vec().createMPI((1 if comm.getRank() == 0 else 0, 1), comm=comm)
+        self.jacobian = mean_jacobian(self.constraint, self.gradient, problem.n, comm)
+        tao = self.tao = PETSc.TAO().create(comm)
+        tao.setOptionsPrefix(settings.prefix)
+        tao.setType("almm")
+        tao.setObjectiveGradient(self._objective_gradient, self.gradient)
+        if hessian is not None:
+            tao.setHessian(lambda *args: None, hessian, hessian)
+        tao.setVariableBounds((self.lower, self.upper))
+        tao.setEqualityConstraints(self._equality, self.constraint)
+        tao.setJacobianEquality(lambda *args: None, self.jacobian, self.jacobian)
+        tao.setTolerances(gatol=0.0, grtol=0.0, gttol=0.0)
+        tao.setMaximumIterations(DEFAULT_MAX_IT)
+        with default_options(defaults or {}, settings.prefix):
+            set_from_options(tao, self.destroy)
+
+    def _objective_gradient(self, tao, x, gradient):
+        value = self.evaluate(x, gradient)
+        if self.history is not None and self.history.out_of_time(self.rule.max_seconds):
+            # The subsolve ends at its next convergence test, and the outer test then reports the time limit.
+            # (A zero gradient did not end it: the augmented Lagrangian's gradient keeps the constraint
+            # term, and a 1024^2 solve ran 100 s past a 10 s limit.)
+            stop_subsolver(tao)
+        return value
+
+    def _equality(self, tao, x, c):
+        c.set(x.sum() / self.problem.n - self.target)
+
+    def keep_best(self, x):
+        """A new best outer iterate (nothing kept by default)."""
+
+    def solve(self, target, unknown, guess=None):
+        """Solve for the mean ``target`` (scaled) from ``unknown`` (overwritten); ``guess`` is unused."""
+        self.target = target
+        self.prepare(unknown)
+        history = self.history = History(self.problem)
+        self.watch = self.rule.watch(history)
+        self.tao.setConvergenceTest(ConvergenceTest(self.watch, self.natural_residual, keep_best=self.keep_best))
+        self.tao.setSolution(unknown)
+        self.tao.solve(unknown)
+        reason = self.tao.getConvergedReason()
+        separation = self.finish(unknown, reason)
+        return Outcome(separation, self.tao.getIterationNumber(),
+                       describe_stop(reason, self.watch, load_control=True), history.as_array())
+
+    def destroy(self):
+        self.tao.destroy()
+        for obj in (self.gradient, self.lower, self.upper, self.constraint, self.jacobian):
+            obj.destroy()
+
+
+class ALMMLoad(MeanConstrainedALMM):
     """Load control by TAO ALMM: ``min 1/2 p'Kp - p'h`` with ``p >= 0`` and ``mean(p) = pbar``.
 
     The multiplier of the equality is the separation; it is recovered from the
@@ -37,48 +125,15 @@ class ALMMLoad(Backend):
     Parameters are those of the registry's factories (``control`` is "load", ``name`` "almm").
     """
 
-    name = "almm"
-
     def __init__(self, problem, control, name, settings):
-        self.problem = problem
-        self.rtol = settings.rtol
-        self.max_seconds = settings.max_seconds
-        self.target = 0.0
-        self.history = None
-        comm = problem.comm
-        self.gradient = problem.vec()
+        self.separation = 0.0
         self.gap_vec = problem.vec()
         self.objective = QuadraticObjective(problem, increments=False)  # at separation 0: f = p'Kp/2 - p'h
         self.hessian = problem.operator.mat()
-        self.lower = problem.vec()
-        self.lower.set(0.0)
-        self.upper = problem.vec()
-        self.upper.set(PETSc.INFINITY if problem.upper_bound is None else problem.upper_bound)
-        self.constraint = PETSc.Vec().createMPI((1 if comm.getRank() == 0 else 0, 1), comm=comm)
-        self.jacobian = mean_jacobian(self.constraint, self.gradient, problem.n, comm)
-        tao = self.tao = PETSc.TAO().create(comm)
-        tao.setOptionsPrefix(settings.prefix)
-        tao.setType("almm")
-        tao.setObjectiveGradient(self._objective_gradient, self.gradient)
-        tao.setHessian(lambda *args: None, self.hessian, self.hessian)
-        tao.setVariableBounds((self.lower, self.upper))
-        tao.setEqualityConstraints(self._equality, self.constraint)
-        tao.setJacobianEquality(lambda *args: None, self.jacobian, self.jacobian)
-        tao.setTolerances(gatol=0.0, grtol=0.0, gttol=0.0)
-        tao.setMaximumIterations(DEFAULT_MAX_IT)
-        set_from_options(tao, self.destroy)
+        super().__init__(problem, settings, problem.upper_bound, self.hessian)
 
-    def _objective_gradient(self, tao, x, gradient):
-        objective = self.objective.evaluate(x, gradient)
-        if self.history is not None and self.history.out_of_time(self.max_seconds):
-            # The subsolve ends at its next convergence test, and the outer test then reports the time limit.
-            # (A zero gradient did not end it: the augmented Lagrangian's gradient keeps the constraint
-            # term, and a 1024^2 solve ran 100 s past a 10 s limit.)
-            stop_subsolver(tao)
-        return objective
-
-    def _equality(self, tao, x, c):
-        c.set(x.sum() / self.problem.n - self.target)
+    def evaluate(self, x, gradient):
+        return self.objective.evaluate(x, gradient)
 
     def gap_of(self, x):
         """The gap of ``x`` at the separation that zeroes its mean on the contact set (PK's choice)."""
@@ -89,24 +144,24 @@ class ALMMLoad(Backend):
         np.add(elastic_gap, self.separation, out=gap)
         return gap
 
-    def solve(self, pbar, pressure, guess=None):
-        """Solve for the mean pressure ``pbar`` (scaled) from ``pressure``; ``guess`` is unused."""
-        self.target = pbar
-        history = self.history = History(self.problem)
-        test = ConvergenceTest(self.problem.mpi, self.problem.n, self.rtol, self.gap_of, history, target_pbar=pbar,
-                               max_seconds=self.max_seconds, upper=self.problem.upper_bound)
-        self.tao.setConvergenceTest(test)
+    def natural_residual(self, tao):
+        """The natural residual and load error of the outer iterate, at PK's separation."""
+        x = tao.getSolution()
+        problem = self.problem
+        kkt = report(problem.mpi, x.getArray(readonly=True), self.gap_of(x), problem.n, self.target,
+                     problem.upper_bound)
+        return kkt.natural, kkt.load_error, True
+
+    def prepare(self, pressure):
         self.objective.restart()
-        self.tao.setSolution(pressure)
-        self.tao.solve(pressure)
+
+    def finish(self, pressure, reason):
         self.gap_of(pressure)
-        return Outcome(self.separation, self.tao.getIterationNumber(), describe_stop(self.tao, test),
-                       history.as_array())
+        return self.separation
 
     def destroy(self):
-        self.tao.destroy()
-        for obj in (self.gradient, self.gap_vec, self.objective, self.hessian, self.lower, self.upper, self.constraint,
-                    self.jacobian):
+        super().destroy()
+        for obj in (self.gap_vec, self.objective, self.hessian):
             obj.destroy()
 
 

@@ -9,13 +9,14 @@ displacement control; under load control the same names mean the root find on d
 import numpy as np
 from petsc4py import PETSc
 
+from ..contact.certificate import report
 from ..errors import UserError
-from ..kkt import ConvergenceTest, History
-from ..preconditioner import FourierPreconditioner
 from .objective import QuadraticObjective
-from .protocol import Backend, Outcome, describe_stop
+from .options import default_options, set_from_options
+from .preconditioner import FourierPreconditioner
+from .protocol import Backend, Outcome
 from .registry import register
-from .tao_options import DEFAULT_MAX_IT, default_options, option_name, set_from_options
+from .stopping import DEFAULT_MAX_IT, ConvergenceTest, History, describe_stop, option_name
 
 BOUND_TYPES = ("blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bqnktl", "bnls", "bntr", "bntl", "tron", "gpcg")
 # Types whose Newton step is a KSP solve on the free set: they take the Fourier preconditioner.
@@ -25,6 +26,10 @@ BOUND_TYPES = ("blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bqnktl", "bnls", "
 KSP_TYPES = ("bnls", "bntr", "bntl", "tron", "gpcg")
 FOURIER_DEFAULT_TYPES = ("bnls", "bntr", "bntl")
 BOUND_PRECONDITIONERS = ("fourier", "none", "options")
+OPTIONS = [
+    ("bound_pc", "", "TAO bnls/bntr/bntl/tron/gpcg: fourier (inverse symbol on the free set; default of the BNK "
+                     "types) | none (default of tron, gpcg) | options (-tao_*pc_type decides)"),
+]
 
 # Restarts of a TAO solve that stopped for round-off (BoundQP.solve): at most this many, and only
 # while each attempt lowers the best natural residual below this fraction of the previous one.
@@ -62,7 +67,7 @@ class BoundQP(Backend):
 
     def __init__(self, problem, control, tao_type, settings):
         self.problem = problem
-        self.rtol = settings.rtol
+        self.rule = settings.rule
         self.max_seconds = settings.max_seconds
         self.objective = QuadraticObjective(problem)
         self.best = problem.vec()  # the best iterate of a solve (lowest natural residual)
@@ -137,8 +142,8 @@ class BoundQP(Backend):
         """
         self.objective.restart(separation)
         history = history or History(self.problem)
-        test = ConvergenceTest(self.problem.mpi, self.problem.n, self.rtol, self.objective.gap_of, history,
-                               max_seconds=self.max_seconds, best=self.best, upper=self.problem.upper_bound)
+        watch = self.rule.watch(history)
+        test = ConvergenceTest(watch, self._natural_residual, keep_best=lambda x: x.copy(self.best))
         self.tao.setConvergenceTest(test)
         # A start outside the bounds would be projected by TAO anyway; do it here.
         local = self.problem.local(pressure)
@@ -158,11 +163,19 @@ class BoundQP(Backend):
                 break
             floor = test.best_natural
             restarts += 1
-            test.stopped_by, test.since_best = None, 0
+            watch.restart(iterations - 1)  # the next solve's first iteration, numbered iterations, counts one
             self.best.copy(pressure)
         if reason < 0 and np.isfinite(test.best_natural):
             self.best.copy(pressure)
-        return Outcome(separation, iterations, describe_stop(self.tao, test, restarts), history.as_array())
+        return Outcome(separation, iterations, describe_stop(reason, watch, restarts), history.as_array())
+
+    def _natural_residual(self, tao):
+        """The natural residual of TAO's iterate on its gap (the objective's cache): the convergence test's input."""
+        x = tao.getSolution()
+        problem = self.problem
+        kkt = report(problem.mpi, x.getArray(readonly=True), self.objective.gap_of(x), problem.n, None,
+                     problem.upper_bound)
+        return kkt.natural, None, True
 
     def destroy(self):
         self.tao.destroy()
@@ -172,4 +185,4 @@ class BoundQP(Backend):
                 obj.destroy()
 
 
-register(BOUND_TYPES, BoundQP, controls=("displacement",))
+register(BOUND_TYPES, BoundQP, controls=("displacement",), options=OPTIONS)

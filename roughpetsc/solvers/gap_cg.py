@@ -1,4 +1,4 @@
-"""Projected conjugate gradients on the gap for adhesive contact (:mod:`roughpetsc.adhesive`).
+"""Projected conjugate gradients on the gap for adhesive contact (:class:`roughpetsc.contact.AdhesiveProblem`).
 
 The algorithm of Rey, Anciaux and Molinari (Comput. Mech. 60, 2017), Polonsky-Keer's CG with the gap
 as the unknown and the mean gap as the constraint, with three changes of ours:
@@ -21,10 +21,14 @@ lowest it saw (a copy is kept each time the residual halves, not at every iterat
 """
 
 import numpy as np
+from petsc4py import PETSc
 
-from ..kkt import STAGNATION_ITERATIONS, History, allsum
-from .. import kernels
-from .protocol import Outcome
+from ..parallel import allsum
+from ..contact import loops
+from .options import python_tao
+from .protocol import Backend, Outcome
+from .registry import register
+from .stopping import ConvergenceTest, History, Verdict, check_convergence, describe_stop
 
 REFRESH = 50  # recompute S g at least every REFRESH iterations (the update S g -= step S t drifts)
 ARMIJO = 1e-4
@@ -50,21 +54,6 @@ def project_mean(mpi, g, target, n):
     np.maximum(g, 0.0, out=g)
 
 
-def gap_cg(adhesive, target):
-    """Solve ``adhesive`` (an :class:`~roughpetsc.adhesive.AdhesiveContact`) at the scaled mean gap ``target``.
-
-    ``adhesive.gap`` holds the start and receives the solution; ``adhesive.elastic`` holds S (g + h) of
-    the last fresh evaluation. Returns an :class:`~roughpetsc.solvers.protocol.Outcome`.
-    """
-    problem = adhesive.problem
-    vecs = [problem.vec() for _ in range(4)]
-    try:
-        return _iterate(adhesive, target, *vecs)
-    finally:
-        for v in vecs:
-            v.destroy()
-
-
 class _Scratch:
     """The local arrays of one solve, allocated once: the loop makes no N^2 temporaries."""
 
@@ -78,103 +67,161 @@ class _Scratch:
         self.best = np.empty(size)  # an iterate near the lowest natural residual, returned by a stop short of it
 
 
-def _iterate(adhesive, target, direction_vec, response_vec, preconditioned_vec, previous_vec):
-    problem = adhesive.problem
-    operator, mpi, n = problem.operator, problem.mpi, problem.n
-    law = adhesive.scaled_law
-    g = problem.local(adhesive.gap).ravel()
-    elastic = problem.local(adhesive.elastic).ravel()
-    t = problem.local(direction_vec).ravel()
-    response = problem.local(response_vec).ravel()
-    z = problem.local(preconditioned_vec).ravel()
-    r_old = problem.local(previous_vec).ravel()
-    scratch = _Scratch(g.size)
-    r, work, free = scratch.r, scratch.work, scratch.free
-    t[...] = 0.0
-    r_old[...] = 0.0
-    project_mean(mpi, g, target, n)
-    history = History(problem)
-    rz_old, fresh_needed, since_fresh = 1.0, True, 0
-    best, best_iteration, saved, stopped_by = np.inf, 0, np.inf, None
-    iteration, reason = 0, "DIVERGED_MAXITS"
-    while True:
-        if fresh_needed or since_fresh >= REFRESH:
-            adhesive.elastic_pressure(adhesive.gap, adhesive.elastic)
-            fresh_needed, since_fresh = False, 0
-        adhesive.gradient(g, elastic, r)
-        lam, open_count = adhesive.multiplier(g, r, scratch.open)
-        natural = adhesive.natural(g, r, lam)
-        if natural <= adhesive.rtol and since_fresh:
-            fresh_needed = True  # confirm on a freshly computed S g
-            continue
-        history.record(iteration, natural)
-        if natural <= adhesive.rtol:
-            reason = "CONVERGED_USER"
-            break
-        if natural < best:
-            best, best_iteration = natural, iteration
-            if natural <= 0.5 * saved:  # an N^2 copy per halving of the residual, not per iteration
-                saved = natural
-                np.copyto(scratch.best, g)
-        if iteration >= adhesive.max_iter:
-            break
-        if history.out_of_time(adhesive.max_seconds):
-            reason, stopped_by = "DIVERGED_USER", "time limit"
-            break
-        if iteration - best_iteration >= STAGNATION_ITERATIONS:
-            reason, stopped_by = "DIVERGED_USER", "stagnation"
-            break
-        # The free set: out of contact, and the contact nodes that pull (they open along the direction);
-        # the residual on it, at zero mean there (directions keep the mean gap).
-        count, total = allsum(mpi, kernels.gap_free_residual(r, lam, scratch.open, free, response))
-        kernels.shift_on(response, free, total / count, response)
-        operator.displacement(response_vec, preconditioned_vec)
-        _restrict(mpi, z, free, count)
-        rz, r_old_z, t_free, z_sum = allsum(mpi, kernels.conjugacy_sums(response, z, r_old, t, free, True))
-        beta = max((rz - r_old_z) / rz_old, 0.0) if iteration else 0.0
-        rz_old = rz
-        # t = beta t + z, at zero mean on the free set.
-        kernels.new_direction(t, free, beta, (beta * t_free + z_sum) / count, z)
-        slope = _feasible(mpi, t, r, scratch.open, open_count)
-        if not slope > 0:
-            # Not a descent direction once feasible: the projected residual is one (CG restarts).
-            np.copyto(t, response)
-            slope = _feasible(mpi, t, r, scratch.open, open_count)
-            r_old[...] = 0.0
-            if not slope > 0:
-                reason, stopped_by = "DIVERGED_LS_FAILURE", "no feasible descent direction (round-off)"
+class GapCG:
+    """The projected CG on the gap as the context of a TAO of type ``python`` (so -tao_monitor, -tao_max_it work).
+
+    Before ``tao.solve`` set :attr:`target` (the scaled mean gap). The TAO's solution is the gap; it holds
+    the start and receives the solution. The stopping rule is checked through the TAO's convergence test
+    once per iteration, on a freshly computed S g before convergence is declared.
+
+    Parameters
+    ----------
+    problem : AdhesiveProblem
+    rule : StoppingRule
+    """
+
+    def __init__(self, problem, rule):
+        self.problem = problem
+        self.rule = rule
+        self.target = None
+        self.watch = None
+        self.history = None
+        self.failure = None  # why the line search gave up, when it did
+        self.current = None  # (natural, None, fresh) of the iterate the convergence test judges
+        self.vecs = [problem.vec() for _ in range(5)]  # direction, S t, preconditioned, previous r, S (g + h)
+
+    def setFromOptions(self, tao):
+        pass
+
+    def view(self, tao, viewer):
+        viewer.printfASCII(f"  projected CG on the gap (Rey-Anciaux-Molinari), preconditioned by the compliance; "
+                           f"S g refreshed every {REFRESH} iterations; stops at a natural residual of "
+                           f"{self.rule.rtol:g}\n")
+
+    def destroy(self, tao=None):
+        for v in self.vecs:
+            v.destroy()
+        self.vecs = []
+
+    def solve(self, tao):
+        problem = self.problem
+        operator, mpi, n = problem.operator, problem.mpi, problem.n
+        law = problem.scaled_law
+        target = self.target
+        gap_vec = tao.getSolution()
+        direction_vec, response_vec, preconditioned_vec, previous_vec, elastic_vec = self.vecs
+        g = problem.local(gap_vec).ravel()
+        elastic = problem.local(elastic_vec).ravel()
+        t = problem.local(direction_vec).ravel()
+        response = problem.local(response_vec).ravel()
+        z = problem.local(preconditioned_vec).ravel()
+        r_old = problem.local(previous_vec).ravel()
+        scratch = _Scratch(g.size)
+        r, work, free = scratch.r, scratch.work, scratch.free
+        t[...] = 0.0
+        r_old[...] = 0.0
+        project_mean(mpi, g, target, n)
+        self.history = History(problem)
+        self.watch = self.rule.watch(self.history, tao.getMaximumIterations())
+        test = ConvergenceTest(self.watch, lambda tao: self.current)
+        tao.setConvergenceTest(test)
+        tao.setConvergedReason(PETSc.TAO.Reason.CONTINUE_ITERATING)
+        tao.setIterationNumber(0)
+        self.failure = None
+        rz_old, fresh_needed, since_fresh = 1.0, True, 0
+        saved = np.inf
+        iteration, reason = 0, PETSc.TAO.Reason.DIVERGED_MAXITS
+        while True:
+            if fresh_needed or since_fresh >= REFRESH:
+                problem.elastic_pressure(gap_vec, elastic_vec)
+                fresh_needed, since_fresh = False, 0
+            problem.gradient(g, elastic, r)
+            lam, open_count = problem.multiplier(g, r, scratch.open)
+            natural = problem.natural(g, r, lam)
+            self.current = (natural, None, since_fresh == 0)
+            reason = check_convergence(tao)
+            if test.verdict is Verdict.CONFIRM:
+                fresh_needed = True  # confirm on a freshly computed S g
+                continue
+            tao.monitor(its=iteration, res=natural)
+            if reason != PETSc.TAO.Reason.CONTINUE_ITERATING:
                 break
-        operator.elastic_pressure(direction_vec, response_vec)  # S t
-        curvature_elastic, elastic_slope = allsum(mpi, kernels.two_dots(t, response, elastic))
-        curvature = curvature_elastic + _law_curvature(law, mpi, g, t, work)
-        if not curvature > 0:
-            curvature = curvature_elastic
-        step = _armijo_step(adhesive, g, t, slope, curvature_elastic, elastic_slope, slope / curvature, work,
-                            scratch.law)
-        if step is None:
-            reason, stopped_by = "DIVERGED_LS_FAILURE", "no decrease of the energy along the direction"
-            break
-        if allsum(mpi, [kernels.gap_step(g, t, step)])[0]:
-            project_mean(mpi, g, target, n)
-            fresh_needed = True
-        else:
-            kernels.subtract_scaled(elastic, response, step)
-        since_fresh += 1
-        iteration += 1
-    notes = [stopped_by] if stopped_by else []
-    if not reason.startswith("CONVERGED") and np.isfinite(best):
-        if natural > saved:  # natural: the residual of the last iterate, the one g holds
-            np.copyto(g, scratch.best)  # the caller certifies it afresh
-            natural = saved
-        notes.append(f"best natural residual {natural:.2g}")
-    return Outcome(separation=target, iterations=iteration,
-                   reason=f"{reason} ({', '.join(notes)})" if notes else reason, history=history.as_array())
+            if self.watch.improved and natural <= 0.5 * saved:
+                saved = natural  # an N^2 copy per halving of the residual, not per iteration
+                np.copyto(scratch.best, g)
+            # The free set: out of contact, and the contact nodes that pull (they open along the direction);
+            # the residual on it, at zero mean there (directions keep the mean gap).
+            count, total = allsum(mpi, loops.gap_free_residual(r, lam, scratch.open, free, response))
+            loops.shift_on(response, free, total / count, response)
+            operator.displacement(response_vec, preconditioned_vec)
+            _restrict(mpi, z, free, count)
+            rz, r_old_z, t_free, z_sum = allsum(mpi, loops.conjugacy_sums(response, z, r_old, t, free, True))
+            beta = max((rz - r_old_z) / rz_old, 0.0) if iteration else 0.0
+            rz_old = rz
+            # t = beta t + z, at zero mean on the free set.
+            loops.new_direction(t, free, beta, (beta * t_free + z_sum) / count, z)
+            slope = _feasible(mpi, t, r, scratch.open, open_count)
+            if not slope > 0:
+                # Not a descent direction once feasible: the projected residual is one (CG restarts).
+                np.copyto(t, response)
+                slope = _feasible(mpi, t, r, scratch.open, open_count)
+                r_old[...] = 0.0
+                if not slope > 0:
+                    reason, self.failure = PETSc.TAO.Reason.DIVERGED_LS_FAILURE, \
+                        "no feasible descent direction (round-off)"
+                    break
+            operator.elastic_pressure(direction_vec, response_vec)  # S t
+            curvature_elastic, elastic_slope = allsum(mpi, loops.two_dots(t, response, elastic))
+            curvature = curvature_elastic + _law_curvature(law, mpi, g, t, work)
+            if not curvature > 0:
+                curvature = curvature_elastic
+            step = _armijo_step(problem, g, t, slope, curvature_elastic, elastic_slope, slope / curvature, work,
+                                scratch.law)
+            if step is None:
+                reason, self.failure = PETSc.TAO.Reason.DIVERGED_LS_FAILURE, \
+                    "no decrease of the energy along the direction"
+                break
+            if allsum(mpi, [loops.gap_step(g, t, step)])[0]:
+                project_mean(mpi, g, target, n)
+                fresh_needed = True
+            else:
+                loops.subtract_scaled(elastic, response, step)
+            since_fresh += 1
+            iteration += 1
+            tao.setIterationNumber(iteration)
+        if reason < 0 and np.isfinite(self.watch.best_natural) and natural > saved:
+            np.copyto(g, scratch.best)  # an iterate within a factor 2 of the best; the facade certifies it
+        tao.setIterationNumber(iteration)
+        tao.setConvergedReason(reason)
+
+
+class GapCGBackend(Backend):
+    """:class:`GapCG` as the backend ``gapcg`` of the adhesive problem (displacement control)."""
+
+    def __init__(self, problem, control, name, settings):
+        self.problem = problem
+        self.context = GapCG(problem, settings.rule)
+        self.tao = python_tao(problem.comm, self.context, settings.prefix)
+        self.name = "gapcg"
+
+    def solve(self, target, gap, guess):
+        """Solve at the scaled mean gap ``target`` from ``gap`` (overwritten); ``guess`` is unused."""
+        self.context.target = target
+        self.tao.setSolution(gap)
+        self.tao.solve(gap)
+        reason = describe_stop(self.tao.getConvergedReason(), self.context.watch, note=self.context.failure)
+        return Outcome(separation=target, iterations=self.tao.getIterationNumber(), reason=reason,
+                       history=self.context.history.as_array())
+
+    def destroy(self):
+        self.tao.destroy()
+        self.context.destroy()
 
 
 def _restrict(mpi, v, free, count):
     """``v`` restricted to the free set (a 0/1 float mask) and shifted to zero mean there (in place)."""
-    total, = allsum(mpi, [kernels.masked_sum(v, free)])
-    kernels.shift_on(v, free, total / count, v)
+    total, = allsum(mpi, [loops.masked_sum(v, free)])
+    loops.shift_on(v, free, total / count, v)
 
 
 def _law_curvature(law, mpi, g, t, work):
@@ -195,12 +242,12 @@ def _feasible(mpi, t, r, open_nodes, open_count):
     steps along -t then need no projection, so the energy change of the line search is that of the
     projected iterate.
     """
-    total, = allsum(mpi, [kernels.close_contact_nodes(t, open_nodes)])
-    slope, = allsum(mpi, [kernels.shift_open_slope(t, open_nodes, total / open_count, r)])
+    total, = allsum(mpi, [loops.close_contact_nodes(t, open_nodes)])
+    slope, = allsum(mpi, [loops.shift_open_slope(t, open_nodes, total / open_count, r)])
     return slope
 
 
-def _armijo_step(adhesive, g, t, slope, curvature_elastic, elastic_slope, step, trial, law_scratch):
+def _armijo_step(problem, g, t, slope, curvature_elastic, elastic_slope, step, trial, law_scratch):
     """The first of ``step``, step/2, ... along -t that decreases the energy enough (None if none does).
 
     The test is on the energy along the line before the projection (phi continued below g = 0 by its
@@ -209,7 +256,7 @@ def _armijo_step(adhesive, g, t, slope, curvature_elastic, elastic_slope, step, 
     the solution: the elastic part is the quadratic -s <S(g + h), t> + s^2/2 <t, S t>, the law's part
     sum (phi(g - s t) - phi(g)). ``trial`` and the two arrays of ``law_scratch`` are scratch of g's size.
     """
-    law, mpi = adhesive.scaled_law, adhesive.problem.mpi
+    law, mpi = problem.scaled_law, problem.mpi
     changes = law.energy_changes_from(g, law_scratch)
     for _ in range(MAX_BACKTRACKS):
         np.multiply(t, -step, out=trial)
@@ -220,3 +267,6 @@ def _armijo_step(adhesive, g, t, slope, curvature_elastic, elastic_slope, step, 
             return step
         step *= 0.5
     return None
+
+
+register("gapcg", GapCGBackend, controls=("displacement",), kinds=("adhesive",))

@@ -1,26 +1,60 @@
-"""Results along a list of loads, through one warm-started :class:`~roughpetsc.solvers.solver.Solver`."""
+"""The one load-path driver: a solver along a list of loads, each step warm-started, a callback after each.
+
+The command line's path (``-pstar_list``, ``-gbar_list``), the ensembles (the history (7.11) per surface),
+the adhesive approach-retraction cycles and the studies all run :func:`drive`; :func:`load_path` is its
+generator for the Python API, making and destroying the :class:`~roughpetsc.solvers.facade.Solver`.
+"""
+
+from petsc4py import PETSc
 
 from ..errors import ParameterError
+from .facade import Solver
 from .registry import resolve
-from .solver import Solver
+
+LOAD_KINDS = ("pstar", "pbar", "gbar")
 
 
-def load_path(problem, pstars=None, pbars=None, gbars=None, tao_type=None, rtol=1e-8, prefix=None):
+def drive(solver, steps, on_step=None, first=0):
+    """Solve ``steps`` (``(kind, value)`` pairs, kind one of pstar, pbar, gbar) in order with ``solver``.
+
+    Each step runs in a PETSc log stage of its own (``-log_view``: ``RP step NNN kind=value``); ``on_step(index,
+    kind, value, result)`` is called after each, before the next starts (it may record, checkpoint, print or
+    raise to stop). ``first`` skips the steps before it (a resumed path). Yields each result.
+    """
+    for index, (kind, value) in enumerate(steps):
+        if index < first:
+            continue
+        if kind not in LOAD_KINDS:
+            raise ParameterError("steps", f"a step is ('pstar' | 'pbar' | 'gbar', value), got '{kind}'")
+        stage = PETSc.Log.Stage(f"RP step {index:03d} {kind}={value:g}")
+        stage.push()
+        try:
+            result = solver.solve(**{kind: value})
+        finally:
+            stage.pop()
+        if on_step is not None:
+            on_step(index, kind, value, result)
+        yield result
+
+
+def load_path(problem, pstars=None, pbars=None, gbars=None, tao_type=None, rtol=1e-8, prefix=None, options=None,
+              on_step=None):
     """A generator of :class:`~roughpetsc.contact.Result` along the loads, in the order given.
 
-    Each solve starts from the previous solutions (the load-path predictor of
-    :class:`~roughpetsc.solvers.continuation.LoadContinuation`), as the load history (7.11) of the
-    dissertation is meant to be solved. The Solver is made at the first result and destroyed when the
+    Each solve starts from the previous solutions (the problem's continuation), as the load history (7.11)
+    of the dissertation is meant to be solved. The Solver is made at the first result and destroyed when the
     generator ends or is closed (``close()``, or garbage collection of an unfinished generator).
 
     Parameters
     ----------
-    problem : ContactProblem
+    problem : ContactProblem or AdhesiveProblem
     pstars, pbars, gbars : sequence of float
         Exactly one: the loads as p* = pbar / sqrt(m0^p), as mean pressures, or as mean gaps
-        (displacement control).
-    tao_type, rtol, prefix :
-        As for :class:`~roughpetsc.solvers.solver.Solver`.
+        (displacement control; an adhesive problem takes mean gaps only).
+    tao_type, rtol, prefix, options :
+        As for :class:`~roughpetsc.solvers.facade.Solver`.
+    on_step : callable, optional
+        ``on_step(index, kind, value, result)`` after each step (:func:`drive`).
 
     Examples
     --------
@@ -32,16 +66,15 @@ def load_path(problem, pstars=None, pbars=None, gbars=None, tao_type=None, rtol=
     if len(given) != 1:
         raise ParameterError("pstars", "give exactly one of pstars, pbars, gbars, got "
                                        f"{len(given) or 'none'}")
-    (name, loads), = given.items()
-    control = "displacement" if name == "gbar" else "load"
-    resolve(tao_type, control)  # an unknown solver is refused now, not at the first result
-    return _results(problem, control, name, list(loads), tao_type, rtol, prefix)
+    (kind, loads), = given.items()
+    control = "displacement" if kind == "gbar" else "load"
+    resolve(tao_type, control, problem.kind)  # an unknown solver is refused now, not at the first result
+    return _results(problem, control, [(kind, load) for load in loads], tao_type, rtol, prefix, options, on_step)
 
 
-def _results(problem, control, name, loads, tao_type, rtol, prefix):
-    solver = Solver(problem, control, tao_type, rtol, prefix)
+def _results(problem, control, steps, tao_type, rtol, prefix, options, on_step):
+    solver = Solver(problem, control, tao_type, rtol, prefix, options)
     try:
-        for load in loads:
-            yield solver.solve(**{name: load})
+        yield from drive(solver, steps, on_step)
     finally:
         solver.destroy()

@@ -7,15 +7,22 @@ confirming K p when the facade certifies the result itself (:class:`~roughpetsc.
 """
 
 import numpy as np
-from petsc4py import PETSc
 
+from .options import PARTS_UNUSED_BY_PYTHON_TAO, given_but_unusable, python_tao
 from .polonsky_keer import PolonskyKeer
-from .protocol import Backend, Guess, Outcome, describe_stop
-from .root_find import RootFind
+from .protocol import Backend, Guess, Outcome
 from .registry import register
-from .tao_options import DEFAULT_MAX_IT, default_options, set_from_options
+from .root_find import RootFind
+from .stopping import describe_stop
 
 NAMES = ("pk", "none", "python")
+# The options of Polonsky-Keer, read by PolonskyKeer.setFromOptions under the solver's prefix.
+OPTIONS = [
+    ("pk_pc", "fourier", "Polonsky-Keer preconditioner: fourier (inverse symbol pi E*|k| on the contact set) | none"),
+    ("pk_active_set", "bccg", "Polonsky-Keer active set: bccg (overlapping nodes join the free set, Polak-Ribiere "
+                              "without restarts) | pk (as published: nodes enter after the step, CG restarts)"),
+    ("pk_refresh", 50, "Polonsky-Keer: recompute K p from scratch at least every this many iterations"),
+]
 
 
 class PKBackend(Backend):
@@ -38,20 +45,9 @@ class PKBackend(Backend):
     def __init__(self, problem, control, name, settings):
         self.problem = problem
         self.control = control
-        self.context = PolonskyKeer(problem, settings.rtol, settings.max_seconds)
+        self.context = PolonskyKeer(problem, settings.rule)
         self.prefix = settings.prefix
-        tao = self.tao = PETSc.TAO().create(problem.comm)
-        tao.setOptionsPrefix(settings.prefix)
-        tao.setType(PETSc.TAO.Type.PYTHON)
-        tao.setPythonContext(self.context)
-        tao.setMaximumIterations(DEFAULT_MAX_IT)
-        # -tao_type pk or none names this backend, not a TAO type: this TAO reads "python" instead.
-        with default_options({"tao_type": PETSc.TAO.Type.PYTHON}, settings.prefix, replace=True):
-            set_from_options(tao, self.destroy)
-        if self.context.option_error is not None:
-            error = self.context.option_error
-            self.destroy()
-            raise error
+        self.tao = python_tao(problem.comm, self.context, settings.prefix)
 
     @property
     def name(self):
@@ -59,8 +55,6 @@ class PKBackend(Backend):
 
     def unusable_options(self):
         """Options given for parts this TAO never runs (line search, KSP, PC, other TAO types): reported unused."""
-        from ..options import PARTS_UNUSED_BY_PYTHON_TAO, given_but_unusable
-
         return given_but_unusable(PARTS_UNUSED_BY_PYTHON_TAO, self.prefix)
 
     def solve(self, target, pressure, guess):
@@ -78,8 +72,9 @@ class PKBackend(Backend):
             self.tao.solve(pressure)
         finally:
             context.initial_displacement, context.confirm = None, True
-        return Outcome(context.separation, self.tao.getIterationNumber(), describe_stop(self.tao, context),
-                       context.history.as_array(), confirmed=not context.unconfirmed)
+        reason = describe_stop(self.tao.getConvergedReason(), context.watch, load_control=self.control == "load")
+        return Outcome(context.separation, self.tao.getIterationNumber(), reason, context.history.as_array(),
+                       confirmed=not context.unconfirmed)
 
     def destroy(self):
         self.tao.destroy()
@@ -113,8 +108,7 @@ class PKAtSeparation:
         outcome = self.backend.solve(separation, pressure, Guess())
         self.separation = separation
         if history is not None:
-            offset = history.rows[-1][0] + 1 if history.rows else 0
-            history.rows.extend((offset + row[0], *row[1:]) for row in outcome.history)
+            history.extend(outcome.history)
         return outcome
 
     def destroy(self):
@@ -168,4 +162,4 @@ def make_pk(problem, control, name, settings):
     return PKBackend(problem, control, name, settings)
 
 
-register(NAMES, make_pk)
+register(NAMES, make_pk, options=OPTIONS)

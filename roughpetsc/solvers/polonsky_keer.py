@@ -42,10 +42,11 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..errors import UserError
-from ..kkt import STAGNATION_ITERATIONS, History, KKTReport, allmax, allsum
-from ..preconditioner import FourierPreconditioner
-from .. import kernels
-from .tao_options import option_name
+from .stopping import ConvergenceTest, History, Verdict, check_convergence, option_name
+from ..contact.certificate import KKTReport
+from ..parallel import allmax, allsum
+from .preconditioner import FourierPreconditioner
+from ..contact import loops
 
 PRECONDITIONERS = ("none", "fourier")
 ACTIVE_SETS = ("pk", "bccg")
@@ -66,22 +67,20 @@ class PolonskyKeer:
     Parameters
     ----------
     problem : ContactProblem
-    rtol : float
-        Tolerance on the natural KKT residual (and the load error under load control).
-    max_seconds : float
-        Seconds after which a solve stops with DIVERGED_USER (0: no limit).
+    rule : StoppingRule
+        When a solve stops: through the TAO's convergence test, which :meth:`solve` sets and calls once per
+        iteration (:func:`~roughpetsc.solvers.stopping.check_convergence`), as TAO's own types do.
     """
 
-    def __init__(self, problem, rtol, max_seconds=0.0):
+    def __init__(self, problem, rule):
         self.problem = problem
-        self.rtol = rtol
+        self.rule = rule
         self.target_pbar = None
         self.target_separation = None
         self.separation = 0.0
         self.preconditioner = "fourier"
         self.refresh = 50
         self.active_set = "bccg"
-        self.max_seconds = max_seconds
         self.option_error = None  # what setFromOptions refused, raised by the caller after it returns
         self.history = None
         # K p of the start, if the caller knows it (then the first fresh K p is skipped); cleared by solve.
@@ -90,8 +89,8 @@ class PolonskyKeer:
         # must then certify on a fresh gap and resume if that fails (the Solver facade does).
         self.confirm = True
         self.unconfirmed = False
-        self.best_natural = np.inf  # the lowest natural residual of the last solve
-        self.stopped_by = None      # "time limit" or "stagnation" when the last solve ended so
+        self.watch = None  # the stopping rule's watch of the last solve (its best residual, what stopped it)
+        self.current = None  # (natural, load error, fresh) of the iterate the convergence test judges
         self.vecs = [problem.vec() for _ in range(6)]
         self.fourier = FourierPreconditioner(problem)
 
@@ -124,10 +123,10 @@ class PolonskyKeer:
 
     def view(self, tao, viewer):
         """-tao_view: PK's own settings; the line search and KSP that PETSc then lists are never used."""
-        limit = f"{self.max_seconds:g} s" if self.max_seconds > 0 else "none"
+        limit = f"{self.rule.max_seconds:g} s" if self.rule.max_seconds > 0 else "none"
         for line in (f"Polonsky-Keer CG, active set {self.active_set}, preconditioner {self.preconditioner}, K p "
                      f"refreshed every {self.refresh} iterations",
-                     f"stops at a natural KKT residual (and load error) of {self.rtol:g}; time limit {limit}",
+                     f"stops at a natural KKT residual (and load error) of {self.rule.rtol:g}; time limit {limit}",
                      "(PETSc lists below the line search and KSP that every TAO holds: Polonsky-Keer uses neither, "
                      "and their options are reported as unused)"):
             viewer.printfASCII(f"  {line}\n")
@@ -169,7 +168,11 @@ class PolonskyKeer:
             self.separation = self.target_separation
             self._interference_start(pressure, p, h)
         self.history = History(problem)
-        max_it = tao.getMaximumIterations()
+        self.watch = self.rule.watch(self.history, tao.getMaximumIterations())
+        test = ConvergenceTest(self.watch, lambda tao: self.current, confirm=self.confirm)
+        tao.setConvergenceTest(test)
+        tao.setConvergedReason(PETSc.TAO.Reason.CONTINUE_ITERATING)  # not the verdict of the last solve
+        tao.setIterationNumber(0)
         rz_old, conjugate, fresh_needed = 1.0, False, True
         since_fresh = 0
         if self.initial_displacement is not None:
@@ -178,55 +181,43 @@ class PolonskyKeer:
             self.initial_displacement, fresh_needed, since_fresh = None, False, 1
         self.unconfirmed = False
         iteration, reason = 0, PETSc.TAO.Reason.DIVERGED_MAXITS
-        self.best_natural, self.stopped_by, best_iteration = np.inf, None, 0
         while True:
             if fresh_needed or since_fresh >= self.refresh:
                 operator.displacement(pressure, displacement_vec)
                 since_fresh, fresh_needed = 0, False
             fresh = since_fresh == 0
             # Plastic nodes (their gap may be negative) are not in the contact set that fixes d.
-            count, gap_sum, total = allsum(mpi, kernels.contact_and_gap(p, displacement, h, gap, contact, upper))
+            count, gap_sum, total = allsum(mpi, loops.contact_and_gap(p, displacement, h, gap, contact, upper))
             if load_control and count:  # d makes the mean gap on the contact set zero (a fully plastic
                 self.separation = -gap_sum / count  # contact keeps the last d)
             kkt = self._report(p, gap, total, pbar, upper)
-            converged = kkt.natural <= self.rtol and (kkt.load_error is None or kkt.load_error <= self.rtol)
-            if converged and not fresh and self.confirm:
+            self.current = (kkt.natural, kkt.load_error, fresh)
+            reason = check_convergence(tao)
+            if test.verdict is Verdict.CONFIRM:
                 fresh_needed = True  # confirm on a freshly computed K p before stopping
                 continue
-            self.history.record(iteration, kkt.natural)
             tao.monitor(its=iteration, f=kkt.complementarity, res=kkt.natural, cnorm=kkt.load_error or 0.0)
-            if converged:
-                reason = PETSc.TAO.Reason.CONVERGED_USER
+            if test.verdict is Verdict.CONVERGED:
                 self.unconfirmed = not fresh
-                break
-            if kkt.natural < self.best_natural:
-                self.best_natural, best_iteration = kkt.natural, iteration
-            if iteration >= max_it:
-                break
-            if self.history.out_of_time(self.max_seconds):
-                reason, self.stopped_by = PETSc.TAO.Reason.DIVERGED_USER, "time limit"
-                break
-            if iteration - best_iteration >= STAGNATION_ITERATIONS:
-                # Round-off in the gap bounds the residual from below (its floor); CG then wanders.
-                reason, self.stopped_by = PETSc.TAO.Reason.DIVERGED_USER, "stagnation"
+            if reason != PETSc.TAO.Reason.CONTINUE_ITERATING:
                 break
             # The free set: the contact set, the plastic nodes whose gap opens (they leave the cap), and
             # under BCCG the nodes out of contact that overlap.
             if bccg or not load_control or cap is not None:
-                count, gap_sum = allsum(mpi, kernels.free_set(p, gap, contact, upper, bccg))
+                count, gap_sum = allsum(mpi, loops.free_set(p, gap, contact, upper, bccg))
             else:
                 gap_sum = 0.0  # the free set is the contact set, where d has made the mean gap zero
             # Directions keep the load: under load control the residual has zero mean on the free set.
             mean = gap_sum / count if load_control and gap_sum else 0.0
             r = response
-            kernels.shift_on(gap, contact, mean, r)
+            loops.shift_on(gap, contact, mean, r)
             if precondition:
                 self.fourier.apply(r, z, contact, count, keep_load=load_control)
                 direction = z
             else:
                 direction = r
             rz, r_old_z, t_free, direction_sum = allsum(
-                mpi, kernels.conjugacy_sums(r, direction, r_old, t, contact, bccg))
+                mpi, loops.conjugacy_sums(r, direction, r_old, t, contact, bccg))
             if bccg:
                 # Polak-Ribiere (clipped at 0): conjugacy survives changes of the free set.
                 beta = max((rz - r_old_z) / rz_old if iteration else 0.0, 0.0)
@@ -236,9 +227,9 @@ class PolonskyKeer:
             # Conjugate direction on the free set: t = z + beta t. Under a cap and load control it is kept
             # at zero sum (it keeps the load, which beside capped nodes only a fresh K p could restore).
             shift = (beta * t_free + direction_sum) / count if load_control and cap is not None and count else 0.0
-            kernels.new_direction(t, contact, beta, shift, direction)
+            loops.new_direction(t, contact, beta, shift, direction)
             operator.displacement(direction_vec, response_vec)
-            q_sum, t_sum, numerator, q_dot_t = allsum(mpi, kernels.step_sums(response, contact, t, gap))
+            q_sum, t_sum, numerator, q_dot_t = allsum(mpi, loops.step_sums(response, contact, t, gap))
             # Under load control K t enters less its mean on the contact set (t vanishes off it).
             denominator = q_dot_t - q_sum / count * t_sum if load_control else q_dot_t
             if not denominator > 0:
@@ -246,7 +237,7 @@ class PolonskyKeer:
                 break
             step = numerator / denominator
             # p - step t projected onto [0, upper]; K p - step K t, the displacement of the unprojected step.
-            clipped, total = kernels.take_step(p, t, displacement, response, step, upper)
+            clipped, total = loops.take_step(p, t, displacement, response, step, upper)
             if bccg:
                 changed, total = allsum(mpi, [clipped, total])
                 entering = 0
@@ -261,14 +252,14 @@ class PolonskyKeer:
                 conjugate = entering == 0
             fresh_needed = bool(changed or entering)
             if load_control and cap is None:
-                kernels.rescale(p, displacement, pbar * n / total)
+                loops.rescale(p, displacement, pbar * n / total)
             elif load_control:
                 # Directions keep the load on the free set: it drifts where the projection clipped (then
                 # K p is computed afresh anyway) and slowly otherwise; a drift well inside the tolerance is
                 # left for later, as rescaling beside capped nodes costs a fresh K p.
-                if changed or abs(total - pbar * n) > 0.01 * self.rtol * pbar * n:
+                if changed or abs(total - pbar * n) > 0.01 * self.rule.rtol * pbar * n:
                     fresh_needed |= self._restore_load_below_cap(p, displacement, pbar * n, cap)
-                    if self.stopped_by:
+                    if self.watch.stopped_by:
                         reason = PETSc.TAO.Reason.DIVERGED_USER
                         break
             since_fresh += 1
@@ -283,7 +274,7 @@ class PolonskyKeer:
         problem = self.problem
         mean_p = total / problem.n
         scale = pbar if pbar else (mean_p if mean_p > 0 else 1.0)
-        natural, complementarity = kernels.natural_residual(p, gap, self.separation, scale, upper)
+        natural, complementarity = loops.natural_residual(p, gap, self.separation, scale, upper)
         natural, = allmax(problem.mpi, [natural])
         complementarity, = allsum(problem.mpi, [complementarity])
         return KKTReport(natural=float(natural), complementarity=float(complementarity / total) if total > 0 else 0.0,
@@ -322,7 +313,7 @@ class PolonskyKeer:
         stale = False
         for _ in range(8):
             # Capped nodes hold p = upper exactly (the projection sets them so): the free load is the rest.
-            n_capped, total = allsum(mpi, kernels.capped_load(p, upper))
+            n_capped, total = allsum(mpi, loops.capped_load(p, upper))
             wanted = total_load - upper * n_capped
             if wanted <= 0:
                 # The capped nodes alone carry more than the load: scale every node down, off the cap.
@@ -332,10 +323,10 @@ class PolonskyKeer:
             if not free_load > 0:
                 # Every loaded node is capped and the load wants more: only a larger contact can carry
                 # it, which rescaling cannot make (the caller stops; see CappedPKLoad).
-                self.stopped_by = "the cap carries the whole load"
+                self.watch.stopped_by = "the cap carries the whole load"
                 return True
             scale = wanted / free_load
-            lifted, = allsum(mpi, [kernels.scale_below_cap(p, upper, scale)])
+            lifted, = allsum(mpi, [loops.scale_below_cap(p, upper, scale)])
             if n_capped or stale:
                 stale = True
             else:

@@ -1,45 +1,64 @@
-"""What every solver backend of the contact QP offers the :class:`~roughpetsc.solvers.solver.Solver` facade.
+"""The two protocols of the solver layer: what a problem offers the solvers, and what a backend offers the facade.
 
-A backend solves the scaled QP of :class:`~roughpetsc.contact.ContactProblem` (the contact problem
-(3.41)-(3.44) of the dissertation) for one target:
+**A problem** (:class:`~roughpetsc.contact.ContactProblem`, :class:`~roughpetsc.contact.AdhesiveProblem`):
 
-``solve(target, pressure, guess) -> Outcome``
-    ``target`` is the scaled mean pressure under load control or the scaled rigid separation under
-    displacement control; ``pressure`` is the Vec the backend updates in place (it holds the start);
-    ``guess`` (:class:`Guess`) is what the facade knows about the start, which a backend may use or ignore.
+``kind``
+    The registry's key of its backends (``"contact"``, ``"adhesive"``).
+``controls``
+    The controls it is solved under (``"load"``, ``"displacement"``).
+``comm``, ``mpi``, ``n``, ``operator``, ``vec()``, ``local(vec)``
+    The layout of its unknown: a PETSc Vec distributed by grid rows.
+``target(control, pbar=, pstar=, gbar=)``
+    The prescribed load or mean gap in the problem's scaled units, checked (ParameterError naming it).
+``continuation(keeps_displacement)``
+    The object that holds the unknown (``.unknown``), starts each solve from the previous solutions
+    (``start(target, start) -> Guess``) and remembers the certified ones (``record(target, outcome, work)``).
+``exact(target, control, unknown)``
+    An :class:`Outcome` where the answer is known in closed form (complete contact), else None.
+``certify(unknown, work, outcome, target, control, rtol, solver, started, applications) -> Result``
+    The result of the unknown, its KKT residual computed afresh (into the scratch Vec ``work``).
+``fields(unknown, work, result)``
+    This rank's rows of the pressure and the gap in the problem's units.
+
+**A backend** solves one problem kind for one target:
+
+``solve(target, unknown, guess) -> Outcome``
+    ``target`` as the problem's ``target`` gives it; ``unknown`` is the Vec the backend updates in place
+    (it holds the start); ``guess`` (:class:`Guess`) is what the facade knows about the start.
 ``destroy()``, ``name`` (the solver's name in results), ``tao`` (its TAO object, for monitors).
 
 Optional behaviour is an attribute with a default here, never a type check in the facade:
-``keeps_displacement`` asks the facade to keep K p of its solutions along a load path, so that
+``keeps_displacement`` asks the continuation to keep K p of its solutions along a load path, so that
 :class:`Guess` can carry K p of the next start; an :class:`Outcome` with ``confirmed=False`` (allowed
 by ``Guess.confirm=False``) asks the facade to solve again with ``Guess(confirm=True)`` when its
-certificate on a fresh gap fails (the resume of Polonsky-Keer along a load path).
+certificate fails (the resume of Polonsky-Keer along a load path); ``unusable_options()`` lists options
+given for parts the backend never runs.
 """
 
 from dataclasses import dataclass
-
 import re
 
 import numpy as np
-from petsc4py import PETSc
+
+from .stopping import StoppingRule
 
 
 @dataclass
 class Outcome:
-    """What a backend reports besides the pressure it leaves in its Vec.
+    """What a backend reports besides the unknown it leaves in its Vec.
 
     Attributes
     ----------
     separation : float
-        The rigid separation d of the solution (scaled by sqrt(m0^h)).
+        The rigid separation d of the solution (scaled by sqrt(m0^h)); the mean gap of an adhesive one.
     iterations : int
     reason : str
-        PETSc's converged reason, with notes (:func:`describe_stop`).
+        PETSc's converged reason, with notes (:func:`~roughpetsc.solvers.stopping.describe_stop`).
     history : ndarray (k, 4)
-        Iteration, natural residual, operator applications, seconds (:class:`~roughpetsc.kkt.History`).
+        Iteration, natural residual, operator applications, seconds (:class:`~roughpetsc.solvers.stopping.History`).
     confirmed : bool
-        False when the backend stopped on an updated gap without a freshly computed one (allowed by
-        ``Guess.confirm = False``): if the facade's certificate then fails, it solves again with
+        False when the backend stopped on an updated gradient without a freshly computed one (allowed by
+        ``Guess.confirm = False``): if the certificate then fails, the facade solves again with
         ``confirm = True``.
     """
 
@@ -62,8 +81,8 @@ class Guess:
         K p of the start, when the load-path predictor knows it (the backend may skip one operator
         application); only offered to backends with ``keeps_displacement``.
     confirm : bool
-        True: the backend confirms its convergence on a freshly computed gap. False: it may stop on an
-        updated gap, because the facade certifies every result on a fresh gap anyway.
+        True: the backend confirms its convergence on a freshly computed gradient. False: it may stop on
+        an updated one, because the facade certifies every result afresh anyway.
     """
 
     separation: float = None
@@ -75,73 +94,57 @@ class Guess:
 class BackendSettings:
     """What every backend is built with besides the problem and its control.
 
-    rtol : float
-        Stopping tolerance on the natural KKT residual (and the load error under load control).
+    rule : StoppingRule
+        The stopping rule of every solve (tolerance, time limit, stagnation).
     prefix : str or None
-        Options prefix of the backend's TAO objects (None: unprefixed options).
-    max_seconds : float
-        Seconds after which a solve stops with DIVERGED_USER (0: no limit).
+        Options prefix of the backend's TAO objects and its own options (None: unprefixed options).
     """
 
-    rtol: float
+    rule: StoppingRule
     prefix: str = None
-    max_seconds: float = 0.0
+
+    @property
+    def rtol(self):
+        return self.rule.rtol
+
+    @property
+    def max_seconds(self):
+        return self.rule.max_seconds
 
 
 class Backend:
-    """The defaults of the optional parts of the backend protocol; backends may derive from it.
-
-    A backend needs ``solve``, ``destroy``, ``name`` and ``tao``; ``keeps_displacement`` defaults to False.
-    """
+    """The defaults of the optional parts of the backend protocol; backends may derive from it."""
 
     keeps_displacement = False
 
-    def solve(self, target, pressure, guess):
+    def solve(self, target, unknown, guess):
         raise NotImplementedError
 
     def destroy(self):
         raise NotImplementedError
 
-
-def reason_name(reason):
-    """PETSc's name of a TAO converged reason."""
-    for name, value in vars(PETSc.TAO.Reason).items():
-        if not name.startswith("_") and value == reason and name not in ("ITERATING", "CONVERGED_ITERATING"):
-            return name
-    return str(reason)
+    def unusable_options(self):
+        return []
 
 
 # The note of describe_stop that quotes the residual of the solver's best iterate.
 BEST_NOTE = re.compile(r"best (of natural residual, load error|natural residual) [^,)]+")
 
 
-def quote_certificate(reason, kkt):
-    """``reason`` with its residual note quoting the result as certified (:class:`~roughpetsc.kkt.KKTReport`).
+def quote_certificate(reason, kkt, load_name="load error"):
+    """``reason`` with its residual note quoting the result as certified (a :class:`~roughpetsc.contact.KKTReport`).
 
-    A solver's own best residual (ALMM's merit, on its cached gap, of an iterate it may not return) can
+    A solver's own best residual (ALMM's merit, on its cached gradient, of an iterate it may not return) can
     differ from the certificate of the result, which the output files record: a stop reason quotes the
     latter, so that the line and the files give the same numbers.
     """
     measured = f"natural residual {kkt.natural:.2g}"
     if kkt.load_error is not None:
-        measured += f", load error {kkt.load_error:.2g}"
+        measured += f", {load_name} {kkt.load_error:.2g}"
     return BEST_NOTE.sub(measured, reason, count=1)
 
 
-def describe_stop(tao, test, restarts=0):
-    """PETSc's reason, with what our convergence test stopped for (time limit, stagnation) and the floor.
-
-    ``test`` is a :class:`~roughpetsc.kkt.ConvergenceTest` or the Polonsky-Keer context (both have
-    ``stopped_by`` and ``best_natural``). A solve that ends short of the tolerance says which natural
-    residual it reached (and, after restarts, that this is the floor that restarting could not
-    lower), so a bare DIVERGED_LS_FAILURE is never the whole story.
-    """
-    name = reason_name(tao.getConvergedReason())
-    notes = [test.stopped_by] if test.stopped_by and name == "DIVERGED_USER" else []
-    if tao.getConvergedReason() < 0 and np.isfinite(test.best_natural):
-        load_control = getattr(test, "target_pbar", None) is not None
-        measure = "of natural residual, load error" if load_control else "natural residual"
-        notes.append(f"best {measure} {test.best_natural:.2g}")
-        if restarts:
-            notes.append(f"floor after {restarts} restart{'s' * (restarts > 1)}")
-    return f"{name} ({', '.join(notes)})" if notes else name
+def not_certified(reason, kkt, load_name="load error", gradient="gap"):
+    """The reason of a result whose solver's own test passed but whose certificate did not."""
+    load = "" if kkt.load_error is None else f", {load_name} {kkt.load_error:.2g}"
+    return f"NOT_CERTIFIED ({reason}, but on a fresh {gradient}: natural residual {kkt.natural:.2g}{load})"

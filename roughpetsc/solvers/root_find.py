@@ -9,7 +9,8 @@ import math
 
 import numpy as np
 
-from ..kkt import History, report
+from .stopping import History
+from ..contact.certificate import report
 from .bound_qp import BOUND_TYPES, BoundQP
 from .protocol import Backend, Outcome
 from .registry import register

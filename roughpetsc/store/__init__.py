@@ -27,7 +27,7 @@ import json
 
 import numpy as np
 
-from ..io import atomic_path, jsonable
+from .outputs import atomic_path, jsonable
 
 
 def write(path, build):

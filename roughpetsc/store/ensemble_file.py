@@ -141,7 +141,7 @@ def _records_from(surfaces, steps, reasons):
 def stored_config(config, options):
     """The configuration JSON of a file, as a dict; a file written before the fractal surface's generator was part
     of it gets the generator its options JSON records (``-surface_generator``, else the option's default)."""
-    from ..surfaces import option_default
+    from ..app.surface_options import option_default
 
     config = json.loads(config)
     surface = config.get("surface", {})

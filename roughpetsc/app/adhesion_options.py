@@ -1,0 +1,108 @@
+"""The command line of adhesive contact (``-adhesion`` in ``-mode solve``): its options, checks and header.
+
+The physics is :mod:`roughpetsc.interaction` (the laws) and :mod:`roughpetsc.adhesive` (the problem and
+its solver); this module only turns options into them and refuses what cannot be combined yet.
+"""
+
+from ..errors import UserError
+from .settings import options_named
+
+OPTIONS = [
+    ("adhesion", "none", "adhesive law: none | dugdale (tension -adhesion_stress up to the range w / sigma0) | "
+                         "exponential (phi = -w exp(-g / rho), rho = -adhesion_range); periodic cell, displacement "
+                         "control (-gbar, -gbar_list), solved for the gap by projected CG (or -tao_type almm)"),
+    ("adhesion_work", 0.0, "work of adhesion w, pressure x length units"),
+    ("adhesion_stress", 0.0, "Dugdale stress sigma0, pressure units (or -adhesion_range h0, then sigma0 = w / h0)"),
+    ("adhesion_range", 0.0, "range of the law, length units: rho (exponential) or h0 (dugdale)"),
+]
+
+
+PARAMETERS = ("adhesion_work", "adhesion_stress", "adhesion_range")
+
+
+def read_law(values, given):
+    """The law of ``-adhesion`` from the option values (None for none), each parameter as the user gave it.
+
+    ``given`` is the set of option names given. A parameter of no law (no ``-adhesion``), one the law
+    does not take (``-adhesion_stress`` of the exponential law) and ``-adhesion_range`` with
+    ``-adhesion_stress`` (two settings of the Dugdale range) are refused; a missing or bad one is
+    refused by :func:`roughpetsc.interaction.make_law`, quoting the value given.
+    """
+    from ..contact.laws import make_law
+
+    kind = values["adhesion"]
+    parameters = [name for name in PARAMETERS if name in given]
+    if kind == "none" and parameters:
+        raise UserError(f"{', '.join('-' + name for name in parameters)} given without -adhesion: choose a law "
+                        "(-adhesion dugdale or exponential), or leave the parameters out")
+    if kind == "dugdale" and {"adhesion_stress", "adhesion_range"} <= given:
+        raise UserError("-adhesion_stress and -adhesion_range both set the Dugdale range (h0 = w / sigma0): give "
+                        "one of them")
+    if kind == "exponential" and "adhesion_stress" in given:
+        raise UserError("-adhesion_stress: the exponential law takes -adhesion_range (its peak stress is w / rho)")
+    with options_named():
+        return make_law(kind, *(values[name] if name in given else None for name in PARAMETERS))
+
+
+def check(settings):
+    """Refuse, by option name, what adhesion cannot be combined with yet."""
+    if settings.control != "displacement":
+        raise UserError(f"-{settings.load_option}: adhesive contact is solved under displacement control (it jumps "
+                        "in and out of contact under load control); prescribe -gbar or -gbar_list")
+    if settings.tao_type not in (None, "almm"):
+        raise UserError(f"-tao_type {settings.tao_type}: the adhesive problem is solved by its projected CG on the "
+                        "gap (no -tao_type) or by TAO ALMM with the mean-gap equality (-tao_type almm)")
+    for refused, given in (("resume", settings.resume),
+                           ("hardness", settings.hardness), ("stress_depths", settings.stress_depths)):
+        if given:
+            raise UserError(f"-{refused} cannot be combined with -adhesion yet (the adhesive problem is solved by "
+                            "its own projected CG on the gap)")
+    if settings.boundary != "periodic":
+        raise UserError("-boundary: adhesion is solved on the periodic cell only")
+
+
+def make_solver(settings, problem):
+    """The adhesive gap solver of the settings (the Solver facade's interface: solve, fields, name, destroy)."""
+    from ..contact.adhesive import AdhesiveContact
+    from ..solvers.options import max_seconds
+
+    return AdhesiveContact(problem, settings.adhesion, settings.kkt_rtol, max_seconds=max_seconds(None),
+                           solver=settings.tao_type or "gapcg")
+
+
+def summary(law, statistics, E_star):
+    """The law, its parameters and Tabor's parameter for a run's summary (``{"law": "none"}`` without one).
+
+    The radius of Tabor's parameter is the mean summit radius of :func:`roughpetsc.adhesive.summit_radius`.
+    """
+    from ..contact.adhesive import summit_radius
+    from ..contact.laws import tabor_parameter
+
+    if law is None:
+        return {"law": "none"}
+    radius = summit_radius(statistics["m4h"])
+    return {"law": law.name, "work": law.work, "range": law.range, "peak_stress": law.peak_stress,
+            "summit_radius": radius, "tabor": tabor_parameter(law, radius, E_star)}
+
+
+def header(law, summary):
+    """The header line of an adhesive run."""
+    return (f"  {law.describe()}; Tabor parameter mu = {summary['tabor']:.4g} "
+            f"(summit radius {summary['summit_radius']:.4g})")
+
+
+def close_cycle(record, say):
+    """A path that returns to its first mean gap is a cycle: its dissipated energy into the summary, and said.
+
+    The energy per unit area -closed integral of pbar dgbar (:func:`roughpetsc.adhesive.dissipated_energy`),
+    pressure x length units; nothing for a path that does not return.
+    """
+    from ..contact.adhesive import dissipated_energy
+
+    steps = record.steps
+    gaps = [step["gbar"] for step in steps]
+    if len(steps) < 3 or abs(gaps[0] - gaps[-1]) > 1e-12 * abs(gaps[0]):
+        return
+    energy = dissipated_energy(gaps, [step["pbar"] for step in steps])
+    record.summary["adhesion"]["dissipated_energy"] = energy
+    say(f"  cycle of {len(steps) - 1} steps: energy dissipated per unit area {energy:.6g} (pressure x length)")

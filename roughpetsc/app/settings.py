@@ -1,0 +1,143 @@
+"""Option tables of the modes and the checks they share: one table feeds ``-help`` and the settings.
+
+A table is a list of :class:`Option` ``(name, default, help)``; the option's type is its default's
+(``int``, ``float``, ``str``, ``bool``). ``roughpetsc.cli`` prints the tables for ``-help`` and
+knows every option name from them; :func:`read_table` reads a whole table from the options
+database, and each mode turns that into its frozen settings dataclass
+(:class:`roughpetsc.stats_mode.StatsSettings`, :class:`roughpetsc.ensemble.settings.EnsembleSettings`).
+
+:data:`GENERAL_OPTIONS` are every mode's; :data:`PARAMETER_OPTIONS` and :func:`user_message` are the one
+translation of a library :class:`~roughpetsc.errors.ParameterError` (a Python parameter, physical
+words) into the option that set it, for the command line and :func:`options_named`.
+
+The checks below are the one place for each: the KKT tolerance, the modulus E* (1.6), the FFT
+threads and planner effort, the random-surface options of an ensemble and the fractal parameters
+(7.1)-(7.2) with their defaults taken from :data:`roughpetsc.surface_options.SURFACE_OPTIONS`. They read
+options, so they raise :class:`~roughpetsc.errors.UserError` naming the option.
+"""
+
+from contextlib import contextmanager
+import math
+from typing import NamedTuple
+
+from ..fft import plans as fftw
+from . import surface_options
+from ..surface.generators import check_fractal_parameters
+from ..errors import ParameterError, UserError
+
+# The general options of every mode (read into each mode's settings; roughpetsc.cli prints them first in -help).
+GENERAL_OPTIONS = [
+    ("mode", "solve", "solve | stats | models | ensemble"),
+    ("E_star", 1.0, "composite modulus E* (1.6), pressure units"),
+    ("overwrite", False, "replace existing output files (without it an existing file is refused, never replaced)"),
+]
+
+# The option that sets each parameter the library names in a ParameterError (roughpetsc.errors), in every mode.
+PARAMETER_OPTIONS = {**{keyword: option for option, keyword in surface_options.FRACTAL_KEYWORDS.items()},
+                     "n1": "surface_N", "n0": "surface_N0/-surface_N", "length": "surface_L",
+                     "kind": "surface_type", "heights": "surface_type", "path": "surface_file",
+                     "amplitude": "surface_amplitude", "wavelength": "surface_wavelength", "radius": "surface_radius",
+                     "effort": "fft_effort", "detrend": "surface_detrend", "E_star": "E_star", "e_star": "E_star", "rtol": "kkt_rtol",
+                     "tao_type": "tao_type", "pstar": "pstar", "pbar": "pbar", "gbar": "gbar",
+                     "boundary": "boundary", "hardness": "hardness", "depths": "stress_depths", "nu": "nu",
+                     **{name: name for name in ("adhesion", "adhesion_work", "adhesion_stress", "adhesion_range")}}
+
+
+def user_message(error):
+    """The one line that reports a bad input on the command line.
+
+    A :class:`UserError` names its option already and is given as it is. A library
+    :class:`ParameterError` names the Python parameter (``k_s``); the option the user typed
+    (``-surface_ks``, :data:`PARAMETER_OPTIONS`) prefixes its message, or the parameter itself if
+    no option sets it.
+    """
+    if not isinstance(error, ParameterError):
+        return str(error)
+    option = PARAMETER_OPTIONS.get(error.parameter)
+    return f"-{option}: {error}" if option else f"{error.parameter}: {error}"
+
+
+@contextmanager
+def options_named():
+    """Turn a :class:`ParameterError` of the library into a :class:`UserError` naming the option that set it
+    (:func:`user_message`)."""
+    try:
+        yield
+    except ParameterError as error:
+        raise UserError(user_message(error)) from None
+
+
+class Option(NamedTuple):
+    """One option of a table: its name (without the dash), its default (whose type is the option's) and help."""
+
+    name: str
+    default: object
+    help: str
+
+    @property
+    def type(self):
+        return type(self.default)
+
+
+def read_table(options, table):
+    """``{name: value}`` of every option of ``table``, read with the getter of its type.
+
+    ``options`` is a ``petsc4py.PETSc.Options`` or a :class:`roughpetsc.options.Reader`.
+    """
+    getters = {int: options.getInt, float: options.getReal, str: options.getString, bool: options.getBool}
+    return {name: getters[type(default)](name, default) for name, default, _ in table}
+
+
+def check_rtol(rtol):
+    """``-kkt_rtol``: the natural KKT residual to stop at, in (0, 1)."""
+    if not 0 < rtol < 1:
+        raise UserError(f"-kkt_rtol must lie in (0, 1), got {rtol}")
+    return rtol
+
+
+def check_modulus(E_star):
+    """``-E_star``: the composite modulus E* (1.6), positive and finite."""
+    if not (E_star > 0 and math.isfinite(E_star)):
+        raise UserError(f"-E_star must be a positive, finite modulus, got {E_star}")
+    return E_star
+
+
+def check_fft(threads, effort):
+    """``-fft_threads`` (>= 1) and ``-fft_effort`` (an FFTW planner flag; :func:`roughpetsc.fftw.planner_effort`)."""
+    if threads < 1:
+        raise UserError(f"-fft_threads must be at least 1, got {threads}")
+    with options_named():
+        fftw.planner_effort(effort)
+    return threads, effort
+
+
+def is_random_surface(options):
+    """True when the options name generated fractal surfaces (no ``-surface_file``, ``-surface_type fractal``)."""
+    return not options.getString("surface_file", "") and options.getString("surface_type", "fractal") == "fractal"
+
+
+def check_ensemble_surfaces(options, option, mode):
+    """An ensemble needs random surfaces whose seeds derive from ``-ensemble_seed`` (:mod:`roughpetsc.seeds`).
+
+    ``option`` names the option that asked for an ensemble (the message names it), ``mode`` the mode.
+    """
+    if not is_random_surface(options):
+        raise UserError(f"-{option}: an ensemble needs random surfaces (-surface_type fractal, no -surface_file)")
+    if options.hasName("surface_seed"):
+        raise UserError(f"-surface_seed is not used by an ensemble of -mode {mode}: the seeds derive from "
+                        "-ensemble_seed")
+
+
+def fractal_parameters(options):
+    """The fractal surface of the options, checked: ``{"type", "N0", "N", "L", "kl", "ks", "H", "m2", "generator"}``.
+
+    Returns ``(grid, parameters)``. Defaults are those of :data:`roughpetsc.surface_options.SURFACE_OPTIONS`
+    (:func:`roughpetsc.surface_options.option_values`); ``L`` is the cell length along x.
+    """
+    given = surface_options.option_values(options, surface_options.TYPE_OPTIONS["fractal"])
+    parameters = {"type": "fractal", "kl": given["surface_kl"], "ks": given["surface_ks"], "H": given["surface_H"],
+                  "m2": given["surface_m2"], "generator": given["surface_generator"]}
+    with options_named():
+        grid = surface_options.grid_from_options(options)
+        check_fractal_parameters(grid, parameters["kl"], parameters["ks"], parameters["H"], parameters["m2"])
+    return grid, dict(parameters, N0=grid.n0, N=grid.n1, L=grid.l1)

@@ -1,0 +1,575 @@
+"""``-mode solve``: one surface, a list of loads solved in order by one Solver, the files of the run.
+
+The option table :data:`OPTIONS` is what ``-help`` prints for the mode; its first part,
+:data:`SETTINGS_OPTIONS`, is read into the frozen :class:`SolveSettings` (with the general options
+of ``roughpetsc.cli``); the rest are read by the solvers themselves from the options database.
+This module imports PETSc only when it runs (``-help`` prints its table before PETSc starts).
+"""
+
+from dataclasses import dataclass, fields
+import os
+import sys
+
+import numpy as np
+
+from . import adhesion_options as adhesive_options
+from ..errors import UserError
+from .settings import GENERAL_OPTIONS, check_fft, check_modulus, check_rtol, options_named, read_table
+
+# Read by read_settings into SolveSettings (besides the loads -pstar, -pbar, -gbar, -pstar_list).
+SETTINGS_OPTIONS = [
+    ("kkt_rtol", 1e-8, "stop when the natural KKT residual ||min(p/pbar, g/sqrt(m0h))||_inf <= this"),
+    ("json", "", "write a JSON summary (surface statistics, one entry per load step) to PATH"),
+    ("output", "", "write an HDF5 file to PATH: heights, the fields of -output_fields, each step's results and "
+                   "residual history, units and descriptions; a load path is saved as its steps finish"),
+    ("output_fields", "last", "pressure and gap fields in -output: last (of the last step) | all (also every "
+                              "step's, in steps/NNN/) | none"),
+    ("resume", False, "continue the load path saved in -output: its converged steps for the same problem and "
+                      "loads are kept, the rest solved from the last saved pressure"),
+    ("plot", "", "write a figure to PATH (.png, .pdf, .svg, ...): pressure and gap maps of the last step, A* "
+                 "against p* of a load path"),
+    ("progress", "auto", "progress lines of a running load step (its step, inner solve, iteration, KKT residual, "
+                         "seconds): auto (only when a person watches: rank 0's output is a terminal, not a pipe or "
+                         "a file, also under mpiexec) | on | off"),
+    ("progress_interval", 3.0, "seconds between progress lines (> 0)"),
+    ("fft_threads", 1, "FFTW threads on one rank"),
+    ("fft_effort", "FFTW_MEASURE", "FFTW planner effort: FFTW_ESTIMATE | FFTW_MEASURE | FFTW_PATIENT "
+                                   "(measured plans are remembered, see -fft_wisdom)"),
+    ("fft_wisdom", "", "FFTW wisdom cache that makes measured plans, and so the iterates, repeat from run to run: "
+                       "PATH, none, or empty for ~/.cache/roughpetsc/fftw-wisdom-<cpu>.json"),
+    ("quiet", False, "print nothing but errors"),
+]
+
+# The physics beyond the periodic elastic half-space (read into SolveSettings).
+PHYSICS_OPTIONS = [
+    ("boundary", "periodic", "periodic (the cell repeats, Westergaard (3.33)) | free (an isolated body: Love's "
+                             "coefficients (3.31) by FFT on the zero-padded 2N x 2N grid)"),
+    ("hardness", 0.0, "hardness H, pressure units: perfect plasticity as the cap 0 <= p <= H (0: no cap); the "
+                      "plastic area fraction A_plastic is reported"),
+    ("stress_depths", "", "comma-separated depths (length units) at which the six subsurface stresses, the von "
+                          "Mises stress and its maximum are computed for the last step and written to -output "
+                          "(/stresses; nothing is computed without this option)"),
+    ("nu", 0.3, "Poisson's ratio of the body, for -stress_depths"),
+] + adhesive_options.OPTIONS
+
+PROGRESS_CHOICES = ("auto", "on", "off")
+
+LOAD_OPTIONS = [
+    ("pstar", 0.5, "load control: p* = pbar / sqrt(m0^p) (the default load)"),
+    ("pbar", "", "load control: mean pressure pbar, pressure units"),
+    ("gbar", "", "displacement control: prescribed mean gap (rigid separation) d, length units"),
+    ("pstar_list", "", "load control: p* values solved in order with warm starts: comma-separated, @FILE (numbers "
+                       "separated by commas, blanks or lines; # comments), or 'history' (the 95 steps of (7.11), "
+                       "D1 = 0.2/30)"),
+    ("pbar_list", "", "load control: mean pressures pbar (pressure units) solved in order with warm starts: "
+                      "comma-separated or @FILE"),
+    ("gbar_list", "", "displacement control: mean gaps (length units) solved in order with warm starts: "
+                      "comma-separated or @FILE (an approach and retraction with -adhesion)"),
+]
+
+# Each load option: the load it sets (a keyword of Solver.solve); the *_list options give several.
+LOAD_KINDS = {"pstar": "pstar", "pbar": "pbar", "gbar": "gbar", "pstar_list": "pstar", "pbar_list": "pbar",
+              "gbar_list": "gbar"}
+
+# Read by the solvers from the options database (roughpetsc.solvers).
+SOLVER_OPTIONS = [
+    ("solve_max_time", 0.0, "stop a solve after this many seconds, reported as DIVERGED_USER (0: no limit)"),
+    ("pk_pc", "fourier", "Polonsky-Keer preconditioner: fourier (inverse symbol pi E*|k| on the contact set) | none"),
+    ("pk_active_set", "bccg", "Polonsky-Keer active set: bccg (overlapping nodes join the free set, Polak-Ribiere "
+                              "without restarts) | pk (as published: nodes enter after the step, CG restarts)"),
+    ("pk_refresh", 50, "Polonsky-Keer: recompute K p from scratch at least every this many iterations"),
+    ("bound_pc", "", "TAO bnls/bntr/bntl/tron/gpcg: fourier (inverse symbol on the free set; default of the BNK "
+                     "types) | none (default of tron, gpcg) | options (-tao_*pc_type decides)"),
+]
+
+OPTIONS = LOAD_OPTIONS + PHYSICS_OPTIONS + SETTINGS_OPTIONS + SOLVER_OPTIONS
+
+SOLVER_HELP = """Solvers (PETSc options):
+  (no -tao_type)          Polonsky-Keer projected CG (TAO type python) with the bound-constrained active set
+                          (-pk_active_set bccg), preconditioned by the inverse Westergaard symbol (-pk_pc fourier);
+                          load control (-pstar/-pbar) or displacement control (-gbar)
+  -tao_type <bound type>  blmvm bqnls bncg bqnkls bqnktr bnls bntr tron gpcg: displacement control directly,
+                          load control by a safeguarded root find on the mean gap around that type
+  -tao_type almm          load control by TAO ALMM (-tao_almm_subsolver_tao_type bqnls|blmvm|...)
+  -tao_monitor, -tao_view, -log_view and every other TAO/KSP/PC option work as usual."""
+
+
+@dataclass(frozen=True)
+class SolveSettings:
+    """What ``-mode solve`` was asked to do, checked; fields are named as the options are.
+
+    ``steps`` are the loads ``(kind, value)`` in solve order, ``kind`` one of ``pstar``, ``pbar``,
+    ``gbar``; ``load_option`` the option that gave them; ``tao_type`` None for Polonsky-Keer.
+    """
+
+    steps: tuple
+    load_option: str
+    E_star: float
+    overwrite: bool
+    kkt_rtol: float
+    json: str
+    output: str
+    output_fields: str
+    resume: bool
+    plot: str
+    progress: str
+    progress_interval: float
+    fft_threads: int
+    fft_effort: str
+    fft_wisdom: str
+    quiet: bool
+    tao_type: object
+    surface_file: str
+    boundary: str = "periodic"
+    hardness: float = None
+    stress_depths: tuple = ()
+    nu: float = 0.3
+    adhesion: object = None
+
+    @property
+    def control(self):
+        """``"displacement"`` for a prescribed mean gap, ``"load"`` otherwise."""
+        return "displacement" if self.steps[0][0] == "gbar" else "load"
+
+    @property
+    def gather_fields(self):
+        """Whether each step's pressure and gap are gathered on rank 0 (a plot or fields in -output)."""
+        return bool(self.plot) or bool(self.stress_depths) or (bool(self.output) and self.output_fields != "none")
+
+
+def load_steps(reader):
+    """The list of loads: ``("pstar" | "pbar" | "gbar", value)`` in the order to solve, and the option."""
+    given = [name for name in LOAD_KINDS if reader.has(name)]
+    if len(given) > 1:
+        raise UserError(f"give only one of {', '.join('-' + name for name in LOAD_KINDS)}; got "
+                        + ", ".join("-" + g for g in given))
+    name = given[0] if given else "pstar"
+    kind = LOAD_KINDS[name]
+    if name == "pstar_list" and reader.string(name, "").strip().lower() == "history":
+        from ..contact import loads
+
+        return [(kind, float(v)) for v in loads.history()], name
+    if name.endswith("_list"):
+        return [(kind, v) for v in reader.reals(name)], name
+    return [(kind, reader.real(name, 0.5))], name
+
+
+def read_settings(reader, general_options=GENERAL_OPTIONS):
+    """The :class:`SolveSettings` of the options database; ``general_options`` is the table of ``-E_star``, ...
+
+    Raises :class:`UserError` naming the option for a bad value.
+    """
+    from ..store.path_record import OUTPUT_FIELDS
+
+    steps, load_option = load_steps(reader)
+    for _, value in steps:
+        if not (value > 0 and np.isfinite(value)):
+            raise UserError(f"-{load_option} must be positive and finite, got {value}")
+    names = {field.name for field in fields(SolveSettings)}
+    values = {name: value for name, value in read_table(reader, general_options + SETTINGS_OPTIONS).items()
+              if name in names}
+    settings = SolveSettings(steps=tuple(steps), load_option=load_option, tao_type=reader.string("tao_type", "") or None,
+                             surface_file=reader.string("surface_file", ""), **values, **read_physics(reader))
+    check_rtol(settings.kkt_rtol)
+    check_modulus(settings.E_star)
+    if settings.output_fields not in OUTPUT_FIELDS:
+        raise UserError(f"-output_fields: unknown value '{settings.output_fields}' (one of {', '.join(OUTPUT_FIELDS)})")
+    if settings.resume and not settings.output:
+        raise UserError("-resume needs -output: the file of the run to continue")
+    check_fft(settings.fft_threads, settings.fft_effort)
+    if settings.progress not in PROGRESS_CHOICES:
+        raise UserError(f"-progress: unknown value '{settings.progress}' (one of {', '.join(PROGRESS_CHOICES)})")
+    if not (settings.progress_interval > 0 and np.isfinite(settings.progress_interval)):
+        raise UserError(f"-progress_interval must be a positive number of seconds, got {settings.progress_interval} "
+                        "(-progress off turns the lines off)")
+    if settings.adhesion is not None:
+        adhesive_options.check(settings)
+    return settings
+
+
+def read_physics(reader):
+    """The values of :data:`PHYSICS_OPTIONS`, checked: ``boundary``, ``hardness`` (None: no cap), ``stress_depths``, ``nu``."""
+    from ..contact.problem import BOUNDARIES
+    from ..elastic.stresses import check_depths, check_poisson
+
+    values = read_table(reader, PHYSICS_OPTIONS)
+    if values["boundary"] not in BOUNDARIES:
+        raise UserError(f"-boundary: unknown boundary '{values['boundary']}' (one of {', '.join(BOUNDARIES)})")
+    hardness = values["hardness"]
+    if not (hardness >= 0 and np.isfinite(hardness)):
+        raise UserError(f"-hardness must be a positive pressure (0: no cap), got {hardness}")
+    depths = tuple(reader.reals("stress_depths")) if reader.has("stress_depths") else ()
+    with options_named():
+        if depths:
+            check_depths(depths)
+        check_poisson(values["nu"])
+    return {"boundary": values["boundary"], "hardness": hardness or None, "stress_depths": depths,
+            "nu": values["nu"],
+            "adhesion": adhesive_options.read_law(values, {name for name in values if reader.has(name)})}
+
+
+def check_files(settings, comm):
+    """Refuse, on every rank, outputs that exist (without -overwrite), overwrite the input or cannot be written.
+
+    Under ``-resume`` the file of -output is meant to exist, and so is a -json summary that this load
+    path wrote (:func:`is_summary_of`): a resumed run rewrites both.
+    """
+    from ..fft import plans as fftw
+    from ..store import outputs as io
+
+    def check():
+        may_exist = ("output",) if settings.resume else ()
+        if settings.resume and is_summary_of(settings.json, settings.output):
+            may_exist += ("json",)
+        io.check_outputs(outputs, settings.overwrite, [("surface_file", settings.surface_file)], may_exist)
+        fftw.check_wisdom_path(settings.fft_wisdom, "fft_wisdom")
+
+    outputs = [("json", settings.json), ("output", settings.output), ("plot", settings.plot)]
+    io.on_root(comm, check)  # checked on rank 0, refused on every rank
+    if settings.plot:
+        io.check_figure_format(settings.plot, "plot")
+
+
+def is_summary_of(json_path, h5_path):
+    """True if ``json_path`` is a solve-mode summary written by a run whose -output was ``h5_path``."""
+    import json
+
+    if not (json_path and h5_path and os.path.isfile(json_path)):
+        return False
+    try:
+        with open(json_path) as handle:
+            document = json.load(handle)
+        recorded = document["options"]["output"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+    return isinstance(document.get("steps"), list) and isinstance(recorded, str) and \
+        os.path.realpath(recorded) == os.path.realpath(h5_path)
+
+
+def printer(quiet, comm):
+    """``say(text)``: print on rank 0 unless ``quiet``."""
+    def say(text):
+        if not quiet and comm.Get_rank() == 0:
+            print(text, flush=True)
+    return say
+
+
+class StepLines:
+    """The lines of finished steps, printed once the output files hold their step.
+
+    With ``-output`` or ``-json`` a step's line waits for the checkpoint that writes the step
+    (:func:`checkpoint`): a run interrupted at any moment has written every step it has printed.
+    Without output files a line is printed at once.
+    """
+
+    def __init__(self, say, hold):
+        self.say = say
+        self.hold = hold
+        self.pending = []
+
+    def add(self, text):
+        if self.hold:
+            self.pending.append(text)
+        else:
+            self.say(text)
+
+    def flush(self):
+        """Print the lines held so far (their steps are now in the files)."""
+        for text in self.pending:
+            self.say(text)
+        self.pending = []
+
+
+def progress_printer(settings, comm):
+    """The progress lines of a running step (:class:`roughpetsc.kkt.Progress`) on rank 0, or None.
+
+    ``-progress on`` or ``off`` decides; ``auto`` prints them when a person watches rank 0's output
+    (:func:`roughpetsc.terminal.watched`: a terminal, also behind mpiexec, never a pipe or a file).
+    """
+    from .progress import Progress
+    from .terminal import watched
+
+    if comm.Get_rank() != 0 or settings.quiet or settings.progress == "off":
+        return None
+    if settings.progress == "auto" and not watched(sys.stdout):
+        return None
+    return Progress(settings.progress_interval, sys.stdout)
+
+
+def run(reader, comm):
+    """Solve the loads of the options on the surface of the options; the exit status (0, 3 or 130).
+
+    From the first check on, Ctrl-C and SIGTERM ask the run to stop (:mod:`roughpetsc.interrupts`):
+    every rank leaves the solve at the same iteration, the files keep every step whose line was
+    printed, and one line says so (exit status 130).
+    """
+    from .interrupts import StopRequests
+
+    settings = read_settings(reader)
+    check_files(settings, comm)
+    with StopRequests() as requests:
+        return solve_settings(settings, reader, comm, requests)
+
+
+def build_problem(settings, reader, comm):
+    """``(grid, heights, problem, levelling)`` of the options: the surface, then the ContactProblem on every rank.
+
+    ``levelling``: the :class:`roughpetsc.files.Levelling` of a surface file, None for a generated surface.
+    """
+    from petsc4py import PETSc
+
+    from ..fft import plans as fftw
+    from . import surface_options
+    from ..surface import files
+    from ..contact.problem import ContactProblem
+    from ..parallel import row_split
+
+    effort = fftw.planner_effort(settings.fft_effort)
+    wisdom = fftw.wisdom_path(settings.fft_wisdom)
+    if not settings.surface_file:
+        # Before the surface is built: a grid with fewer rows than ranks is refused by name.
+        row_split(surface_options.grid_from_options(reader).n0, comm.Get_size())
+    levelling = []
+    grid, heights = surface_options.from_options(reader, notes=levelling)
+    with fftw.remembered_plans(comm, wisdom, effort), options_named():
+        problem = ContactProblem(grid, heights, settings.E_star, PETSc.COMM_WORLD, settings.fft_threads, effort,
+                                 boundary=settings.boundary, hardness=settings.hardness)
+    return grid, heights, problem, (levelling[0] if levelling else None)
+
+
+def solve_settings(settings, reader, comm, requests):
+    """:func:`run` once the settings and files are checked; ``requests`` the :class:`StopRequests` of the run."""
+    from ..store import outputs as io
+    from .. import store
+    from . import surface_options
+    from ..surface import files
+    from .options import check_unused
+    from ..store.path_record import PathRecord
+    from ..surface.moments import surface_moments
+
+    say = printer(settings.quiet, comm)
+    grid, heights, problem, levelling = build_problem(settings, reader, comm)
+    solver = None
+    try:
+        problem.stop_requested = requests.is_set
+        problem.progress = progress_printer(settings, comm)
+        statistics = surface_moments(grid, heights, settings.E_star)
+        solver = make_solver(settings, problem)
+        unusable = getattr(solver, "unusable_options", list)()
+        check_unused(final=False, unusable=unusable)  # misspellings fail now; those read after a solve, then
+        summary = {"grid": [grid.n0, grid.n1], "length": [grid.l0, grid.l1], "E_star": settings.E_star,
+                   "surface": statistics, "surface_parameters": dict(surface_options.parameters(reader), surface_L=grid.l1),
+                   "sqrt_m0h": problem.sqrt_m0h, "sqrt_m0p": problem.sqrt_m0p,
+                   "solver": solver.name, "control": settings.control, "kkt_rtol": settings.kkt_rtol,
+                   "boundary": settings.boundary, "hardness": settings.hardness or 0.0,
+                   "adhesion": adhesive_options.summary(settings.adhesion, statistics, settings.E_star),
+                   "ranks": comm.Get_size(), **io.provenance()}
+        if levelling is not None:
+            summary["surface_levelling"] = levelling.record()
+        # Fields written by every rank into its rows where h5py is the parallel build (store.write_distributed).
+        distributed = bool(settings.output) and settings.output_fields != "none" and store.parallel_hdf5(comm)
+        rows = problem.local_rows
+        record = PathRecord(summary, heights, settings.output_fields,
+                            *((rows.start, rows.stop - rows.start) if distributed else ()))
+        if settings.resume and os.path.exists(settings.output):
+            start = record.resume_from(settings.output, list(settings.steps), settings.load_option)
+            if start is not None:  # the next solve scales it to its load (Solver's warm start)
+                problem.local(solver.pressure)[...] = start[problem.local_rows] / problem.pressure_scale
+        say_header(settings, grid, problem, solver, statistics, summary, say)
+        if levelling is not None:
+            report_levelling(levelling, settings.surface_file, say, comm)
+        for step in record.steps:
+            say(step_line(step) + f"  (from {settings.output})")
+        lines = StepLines(say, hold=bool(settings.output or settings.json))
+        if solve_path(settings, solver, record, comm, lines, requests, problem.progress):
+            io.on_root(comm, report_interruption, settings, record)
+            return 130
+        if settings.adhesion is not None:
+            adhesive_options.close_cycle(record, lines.add)
+        whole = whole_last_fields(record, comm, distributed, settings)
+        if settings.stress_depths:
+            for text in io.on_root(comm, record_stresses, settings, record, grid, whole) or ():
+                lines.add(text)
+        if distributed:
+            record.write(settings.output, comm=comm)
+        io.on_root(comm, write_outputs, settings, record, grid, whole, not distributed)
+        lines.flush()
+        return 0 if all(step["converged"] for step in record.steps) else 3
+    finally:
+        if solver is not None:
+            solver.destroy()
+        problem.destroy()
+
+
+def say_header(settings, grid, problem, solver, statistics, summary, say):
+    """The header of the step table: the problem, the solver, the surface's bandwidths, the column names."""
+    cap = f", hardness {settings.hardness:g}" if settings.hardness else ""
+    say(f"roughpetsc: {grid.n0}x{grid.n1} grid ({settings.boundary}{cap}) on {problem.mpi.Get_size()} rank(s), "
+        f"solver {solver.name}, E*={settings.E_star:g}, sqrt(m0h)={problem.sqrt_m0h:.4g}, "
+        f"sqrt(m0p)={problem.sqrt_m0p:.4g}, alpha_h={statistics['alpha_h']:.4g}, "
+        f"alpha_p={statistics['alpha_p']:.4g}")
+    if settings.adhesion is not None:
+        say(adhesive_options.header(settings.adhesion, summary["adhesion"]))
+    say(f"{'p*':>10} {'A*':>10} {'A*corr':>10} {'g*':>11} {'KKT nat':>9} {'its':>6} {'Kapps':>6} "
+        f"{'time s':>8}  reason")
+
+
+def report_levelling(levelling, path, say, comm):
+    """Rank 0: what levelling a surface file did (stdout) and its warnings (stderr), one line each."""
+    for note in levelling.notes:
+        if note.startswith("warning: ") and comm.Get_rank() == 0:
+            print(f"roughpetsc: warning: -surface_file {path}: {note[len('warning: '):]}", file=sys.stderr, flush=True)
+        elif not note.startswith("warning: "):
+            say(f"  surface: {note}")
+
+
+def report_interruption(settings, record):
+    """Rank 0: the one line of an interrupted run, naming what the files hold (nothing is written now)."""
+    files = " and ".join(path for path in (settings.output, settings.json) if path)
+    held = record.written
+    if files and held:
+        kept = f"; {files} {'keep' if ' and ' in files else 'keeps'} them"
+        kept += " (rerun with -resume to continue)" if settings.output else ""
+    else:
+        kept = "; nothing was written" if files else ""
+    unsaved = len(record.steps) - held if files else 0
+    if unsaved > 0:
+        kept += f"; {unsaved} later step(s) finished but not yet saved are solved again by a rerun"
+    print(f"roughpetsc: interrupted after {held if files else len(record.steps)} of {len(settings.steps)} "
+          f"step(s){kept}", file=sys.stderr, flush=True)
+
+
+def make_solver(settings, problem):
+    """The Solver of ``-tao_type``, or the adhesive gap solver under ``-adhesion``."""
+    if settings.adhesion is not None:
+        return adhesive_options.make_solver(settings, problem)
+    from ..solvers import Solver
+
+    return Solver(problem, settings.control, settings.tao_type, settings.kkt_rtol)
+
+
+def whole_last_fields(record, comm, distributed, settings):
+    """The last step's whole pressure and gap on rank 0 (collective), for the figure and the stresses."""
+    from ..parallel import gather_rows
+
+    if not distributed:
+        return record.last_fields
+    if not (settings.plot or settings.stress_depths) or not record.last_fields:
+        return {}
+    return {name: gather_rows(comm, array) for name, array in record.last_fields.items()}
+
+
+def record_stresses(settings, record, grid, fields):
+    """The subsurface stresses of the last step at ``settings.stress_depths`` into ``record`` (rank 0).
+
+    Returns the lines that report them.
+    """
+    from ..elastic.stresses import free_stresses, periodic_stresses
+
+    pressure = fields.get("pressure")
+    if pressure is None:
+        raise UserError("-stress_depths: the last step's pressure field is not available (all steps taken from a "
+                        "file without fields)")
+    if settings.boundary == "periodic":
+        depths = periodic_stresses(pressure, (grid.l0, grid.l1), settings.stress_depths, settings.nu,
+                                   settings.fft_effort)
+    else:
+        depths = free_stresses(pressure, (grid.l0 / grid.n0, grid.l1 / grid.n1), settings.stress_depths,
+                               settings.nu, settings.fft_effort)
+    record.stresses = list(depths)
+    return [f"  stresses at depth {depth.depth:.4g}: max von Mises {depth.max_von_mises:.4g} at node "
+            f"{depth.max_location}" for depth in record.stresses]
+
+
+def write_outputs(settings, record, grid, fields, with_h5=True):
+    """The JSON, HDF5 (unless written by every rank) and figure of the run (rank 0; a failure there is every
+    rank's error, io.on_root). ``fields``: the last step's whole fields."""
+    from . import plots
+
+    record.write(settings.output if with_h5 else "", settings.json)
+    if settings.plot and not fields:  # every step taken from a file without fields
+        print(f"roughpetsc: -plot: no fields to plot in {settings.output} (-output_fields none)", file=sys.stderr)
+    elif settings.plot:
+        adhesion = record.summary["adhesion"] if settings.adhesion is not None else None
+        plots.plot_solution(settings.plot, grid, fields["pressure"], fields["gap"], record.steps, adhesion)
+
+
+def step_line(step):
+    """The table row of a step summary."""
+    flag = "" if step["converged"] else "  NOT CONVERGED"
+    plastic = f"  A_plastic {step['A_plastic']:.5g}" if step.get("A_plastic") else ""
+    return (f"{step['pstar']:10.5g} {step['A']:10.5g} {step['A_corrected']:10.5g} {step['gstar']:11.5g} "
+            f"{step['kkt']['natural']:9.2e} {step['iterations']:6d} {step['operator_applications']:6d} "
+            f"{step['time_s']:8.3f}  {step['reason']}{flag}{plastic}")
+
+
+def solve_path(settings, solver, record, comm, lines, requests, progress=None):
+    """Solve the loads of ``settings.steps`` not yet in ``record``, recording each and checkpointing the files.
+
+    Each step's pressure and gap are gathered on rank 0 for the record when
+    ``settings.gather_fields``, or kept as this rank's rows when every rank writes its rows of the
+    file (``record.first_row``). Every option must have been used once the
+    first solve is done (PETSc reads viewers and converged reasons during and
+    after TAOSolve); the check runs then, before any file is written.
+
+    Returns True when a stop was requested (``requests``, on any rank): the step that was running is
+    dropped, and nothing more is written. ``progress``: the :class:`roughpetsc.kkt.Progress` to tell
+    of each new step, or None.
+    """
+    from petsc4py import PETSc
+
+    from .interrupts import agreed
+    from .options import check_unused
+    from ..parallel import gather_rows
+
+    checked = False
+    steps = settings.steps
+    for index, (kind, value) in enumerate(steps):
+        if index < len(record.steps):
+            continue
+        if agreed(comm, requests.is_set()):
+            return True
+        if progress is not None:
+            progress.start_step(index, len(steps), kind, value)
+        stage = PETSc.Log.Stage(f"RP step {index:03d} {kind}={value:g}")  # -log_view: one stage per load
+        stage.push()
+        try:
+            result = solver.solve(**{kind: value})
+        finally:
+            stage.pop()
+        if agreed(comm, requests.is_set()) and not result.converged:
+            return True  # stopped by the request: solved again by a rerun
+        solver_ran = not result.reason.startswith("COMPLETE_CONTACT")  # the exact answer runs no TAO
+        if not checked:
+            # Once a TAO solve has run, every option must have been read; before, only those that are
+            # not read during or after a solve (a path wholly beyond complete contact runs none).
+            check_unused(final=solver_ran)
+            checked = solver_ran
+        if record.first_row is not None:
+            fields = [field.copy() for field in solver.fields()]
+        elif settings.gather_fields:
+            fields = [gather_rows(comm, field) for field in solver.fields()]
+        else:
+            fields = [None, None]
+        record.add(dict(result.summary(), load_option=kind, load_value=value), result.history, *fields)
+        lines.add(step_line(result.summary()))
+        # Not before every option is known to be used: a run refused for an unused option writes nothing.
+        if checked and index < len(steps) - 1 and checkpoint(settings, record, comm):
+            lines.flush()
+    return False
+
+
+def checkpoint(settings, record, comm):
+    """Rewrite the files (-output, -json) with the steps so far when it is time to; True if they were written.
+
+    Every rank takes part: a failed write stops them all. Rank 0's clock decides for all.
+    """
+    from ..store import outputs as io
+
+    if not (settings.output or settings.json) or not comm.bcast(record.due(), root=0):
+        return False
+    if record.first_row is not None:
+        record.write(settings.output, settings.json, comm=comm)
+    else:
+        io.on_root(comm, record.write, settings.output, settings.json)
+    return True

@@ -1,0 +1,221 @@
+"""Adhesive contact of a rough surface and a rigid flat in the periodic BEM, the gap as the unknown.
+
+With an interaction law phi (:mod:`roughpetsc.interaction`) the total energy per unit area of a gap
+field g >= 0 at the mean gap gbar (the rigid separation, (3.38)) is
+
+    Pi(g) = 1/2 <g + h, S (g + h)> + <phi(g)>,
+
+``<.>`` the mean over the nodes and ``S`` the stiffness (the inverse symbol pi E* |k| of the Westergaard
+compliance (3.33), zero at k = 0): the surface displacement is u = g - gbar + h and S kills constants.
+The gap stays bound-constrained; the mean gap is the one equality (displacement control). Adhesive
+contact is unstable under load control (it jumps in and out of contact), so paths run under
+displacement control and the load is an output.
+
+First-order conditions, with r = S (g + h) + phi'(g) and a multiplier lambda = -pbar (pbar the mean
+pressure, compressive positive):
+
+* out of contact (g > 0): r = lambda, i.e. the total pressure p = S(g + h) + pbar equals the law's
+  traction -phi'(g);
+* in contact (g = 0): the contact pressure c = r - lambda >= 0.
+
+The natural residual certified after every solve is ``max |min(g / sqrt(m0^h), (r - lambda) /
+sqrt(m0^p))|`` over all nodes, on a gap whose S g is computed afresh, with lambda the mean of r out of
+contact (the best multiplier for those nodes). Its pressure scale sqrt(m0^p) (2.52) is that of the
+non-adhesive problem (the mean pressure may be zero or tensile here). The report's ``load_error`` is
+the error of the prescribed quantity, the mean gap, over sqrt(m0^h); a converged solve has both below
+the tolerance.
+
+Only the periodic boundary is supported (the free boundary's stiffness is not a Fourier filter). The problem
+knows its energy, gradient and certificate; the solvers of :mod:`roughpetsc.solvers` (the projected CG on the
+gap, ``gapcg``, and TAO ALMM, ``almm``) solve it through the :class:`~roughpetsc.solvers.Solver` facade like
+any other problem.
+"""
+
+import math
+import time
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..parallel import allmax, allmin, allsum
+from . import loops
+from .certificate import KKTReport
+from .result import Result, measure
+
+
+class AdhesiveProblem:
+    """A :class:`~roughpetsc.contact.ContactProblem` with an adhesive law, its unknown the gap.
+
+    Parameters
+    ----------
+    problem : ContactProblem
+        Periodic, without a hardness cap. Its surface, operator and units are used; it stays the caller's to
+        destroy.
+    law : laws.Dugdale or laws.Exponential
+        In the problem's units (pressure units of E*, length units of the heights).
+
+    Attributes
+    ----------
+    kind : str
+        ``"adhesive"``: the solvers registered for this kind solve it (:mod:`roughpetsc.solvers.registry`).
+    controls : tuple
+        Displacement control only: adhesive contact jumps in and out of contact under load control.
+    """
+
+    kind = "adhesive"
+    controls = ("displacement",)
+
+    def __init__(self, problem, law):
+        if problem.boundary != "periodic":
+            raise ParameterError("boundary", "adhesion is solved on the periodic cell only")
+        if problem.upper_bound is not None:
+            raise ParameterError("hardness", "adhesion and a hardness cap cannot be combined yet")
+        self.elastic_problem = problem
+        self.law = law
+        self.scaled_law = law.scaled(problem.height_scale, problem.pressure_scale)
+        # The pressure scale of the residual: sqrt(m0^p) (2.52) of the non-adhesive problem, scaled units.
+        self.residual_scale = math.sqrt(problem.m0p_scaled)
+        self.progress = None        # as ContactProblem's: the command line's progress line, Ctrl-C
+        self.stop_requested = None
+
+    # --- what every problem offers the solvers (roughpetsc.solvers.protocol) ---------
+    def __getattr__(self, name):
+        # The layout, units and surface of the elastic problem (comm, mpi, n, operator, vec, local, heights,
+        # height_scale, pressure_scale, ...) are this problem's too.
+        if name == "elastic_problem":
+            raise AttributeError(name)
+        return getattr(self.elastic_problem, name)
+
+    def target(self, control, pbar=None, pstar=None, gbar=None):
+        """The scaled mean gap of ``gbar`` (length units); a load is refused (displacement control only)."""
+        if gbar is None:
+            raise ParameterError("pbar" if pstar is None else "pstar",
+                                 "adhesive contact is solved under displacement control: prescribe the mean "
+                                 "gap (the load jumps where contact snaps in or out)")
+        if not (gbar > 0 and math.isfinite(gbar)):
+            raise ParameterError("gbar", f"the mean gap must be positive and finite, got {gbar}")
+        return gbar / self.height_scale
+
+    def continuation(self, keeps_displacement=False):
+        """The gap and the rule of its starts along a path (:class:`~roughpetsc.contact.continuation.GapContinuation`)."""
+        from .continuation import GapContinuation
+
+        return GapContinuation(self)
+
+    def exact(self, target, control, unknown):
+        """No closed-form answer: every gap is solved."""
+        return None
+
+    # --- the energy and its gradient ------------------------------------------
+    def elastic_pressure(self, gap_vec, out):
+        """``out = S (g + h)``: the elastic pressure less its mean (one operator application)."""
+        self.operator.elastic_pressure(gap_vec, out)
+        out.axpy(1.0, self.pressure_surface)
+
+    def gradient(self, g, elastic, out):
+        """``out = r = S (g + h) + phi'(g)`` of local arrays ``g`` and ``elastic`` = S (g + h)."""
+        self.scaled_law.force(g, out=out)
+        out += elastic
+
+    def multiplier(self, g, r, open_nodes):
+        """lambda, the mean of r out of contact; ``open_nodes`` (bool, contiguous, written) marks g > 0. Also their
+        count."""
+        count, r_sum = allsum(self.mpi, loops.open_sums(g.ravel(), r.ravel(), open_nodes.reshape(-1)))
+        return (r_sum / count if count else 0.0), count
+
+    def natural(self, g, r, lam):
+        """The natural residual max |min(g, (r - lambda) / sqrt(m0^p))| (scaled gaps)."""
+        return float(allmax(self.mpi, [loops.gap_natural(g.ravel(), r.ravel(), lam, self.residual_scale)])[0])
+
+    def stationarity(self, g, elastic):
+        """``(r, lambda, report)`` of local arrays ``g`` and ``elastic`` = S (g + h) (module docstring).
+
+        The report: ``natural`` as above, ``min_p`` the least contact pressure r - lambda in contact and
+        ``complementarity`` the mean of g |r - lambda| out of contact (both over sqrt(m0^p)), ``min_g``.
+        """
+        r = np.empty_like(g)
+        self.gradient(g, elastic, r)
+        out_of_contact = np.empty(g.shape, dtype=bool)
+        lam, _ = self.multiplier(g, r, out_of_contact)
+        natural = self.natural(g, r, lam)
+        excess = (r - lam) / self.residual_scale
+        min_c = np.min(excess, where=~out_of_contact, initial=np.inf)
+        equilibrium = np.abs(excess, where=out_of_contact, out=np.zeros_like(excess))
+        min_c, min_g = allmin(self.mpi, [min_c, g.min()])
+        complementarity, = allsum(self.mpi, [np.dot(equilibrium.ravel(), g.ravel())])
+        kkt = KKTReport(natural=natural, complementarity=float(complementarity / self.n),
+                        min_p=float(min_c) if np.isfinite(min_c) else 0.0, min_g=float(min_g))
+        return r, lam, kkt
+
+    def energy(self, g, elastic):
+        """Pi(g) (scaled, per unit area) of local arrays ``g`` and ``elastic`` = S (g + h)."""
+        h = self.local(self.heights, readonly=True).ravel()
+        e = elastic.ravel()
+        sums = allsum(self.mpi, [0.5 * (np.dot(g.ravel(), e) + np.dot(h, e)), self.scaled_law.energy(g).sum()])
+        return float(sums.sum() / self.n)
+
+    # --- results ----------------------------------------------------------------
+    def certify(self, unknown, work, outcome, target, control, rtol, solver, started, applications):
+        """The :class:`Result` of the gap ``unknown`` at the scaled mean gap ``target``, certified on a fresh S g.
+
+        ``work`` receives S (g + h) (the pressure of :meth:`fields`).
+        """
+        from ..solvers.protocol import not_certified, quote_certificate
+
+        self.elastic_pressure(unknown, work)
+        g = self.local(unknown, readonly=True)
+        elastic = self.local(work, readonly=True)
+        _, lam, kkt = self.stationarity(g, elastic)
+        total, = allsum(self.mpi, [g.sum()])
+        kkt.load_error = abs(total / self.n - target)  # the prescribed mean gap's error, over sqrt(m0^h)
+        converged = kkt.natural <= rtol and kkt.load_error <= rtol
+        reason = outcome.reason if converged else quote_certificate(outcome.reason, kkt, "mean gap error")
+        if not converged and reason.startswith("CONVERGED"):
+            reason = not_certified(reason, kkt, "mean gap error", "S g")
+        in_contact = (g == 0).astype(np.float64)
+        measures = measure(self.elastic_problem, in_contact, g)
+        pbar = -lam * self.pressure_scale
+        gbar = target * self.height_scale
+        return Result(
+            pbar=pbar, pstar=pbar / self.sqrt_m0p, A=measures["A"], A_corrected=measures["A_corrected"],
+            gbar=gbar, gstar=target, separation=gbar, rms_gap_contact=0.0, kkt=kkt,
+            iterations=outcome.iterations, operator_applications=self.operator.applications - applications,
+            time_s=time.perf_counter() - started, reason=reason, converged=converged, solver=solver,
+            control="displacement", history=outcome.history)
+
+    def fields(self, unknown, work, result):
+        """This rank's rows of the total pressure (compressive positive) and the gap of ``result``.
+
+        Pressure and length units. The pressure is S (g + h) + pbar: the contact pressure in contact,
+        the law's traction -phi'(g) out of it.
+        """
+        pressure = self.local(work, readonly=True) * self.pressure_scale + result.pbar
+        return pressure, self.local(unknown, readonly=True) * self.height_scale
+
+
+def summit_radius(m4h):
+    """1 / (mean summit curvature (8/3) sqrt(m4^h / pi)) (Nayak's high-bandwidth limit), length units.
+
+    The radius with which the header's Tabor parameter describes a rough surface.
+    """
+    return 1.0 / (8.0 / 3.0 * math.sqrt(m4h / math.pi))
+
+
+def approach_retraction(gbar_max, gbar_min, steps):
+    """Mean gaps from ``gbar_max`` down to ``gbar_min`` and back up, ``steps`` each way (length units).
+
+    The turning point appears once; a path along it shows the hysteresis of adhesive contact.
+    """
+    down = np.linspace(gbar_max, gbar_min, steps + 1)
+    return np.concatenate([down, down[-2::-1]])
+
+
+def dissipated_energy(gbars, pbars):
+    """Energy dissipated per unit area in one approach-retraction cycle: -closed integral of pbar dgbar.
+
+    d Pi / d gbar = -pbar along every equilibrium branch, so the work -integral pbar dgbar put in
+    around a closed cycle is what the jumps in and out of contact dissipated. Trapezoids over the
+    path (pressure x length units); positive for a hysteresis loop.
+    """
+    gbars, pbars = np.asarray(gbars), np.asarray(pbars)
+    return float(-np.sum(0.5 * (pbars[1:] + pbars[:-1]) * np.diff(gbars)))

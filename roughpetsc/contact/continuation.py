@@ -1,0 +1,202 @@
+"""The warm starts of a path: the unknown of a problem and the start of each solve from the previous solutions.
+
+:class:`PressureContinuation` (the elastic contact problem, pressure as the unknown) and
+:class:`GapContinuation` (the adhesive problem, gap as the unknown) follow the continuation protocol of
+:mod:`roughpetsc.solvers.protocol`: ``unknown``, ``start(control, target, start) -> Guess``,
+``record(control, target, outcome, work)``, ``destroy()``.
+
+Pressure: the start of each load-controlled solve comes from the previous solutions.
+
+After two load-controlled solves the pressure is extrapolated linearly in the load (the predictor of a
+continuation along the load path, e.g. the history (7.11) of the dissertation), projected onto p >= 0
+and scaled to the new mean pressure. For a backend with ``keeps_displacement`` the same combination of
+the kept K p of the previous solutions gives K p of the start (one FFT pair saved per step).
+"""
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..parallel import allsum
+
+
+class PressureContinuation:
+    """The pressure Vec a :class:`~roughpetsc.solvers.solver.Solver` solves in, and what predicts its starts.
+
+    Parameters
+    ----------
+    problem : ContactProblem
+    keeps_displacement : bool
+        Keep K p of the solutions, so that :meth:`start` also returns K p of the start.
+
+    Attributes
+    ----------
+    unknown : petsc4py.PETSc.Vec
+        The pressure (the problem's unknown), below.
+    pressure : petsc4py.PETSc.Vec
+        The current pressure (scaled): the start before a solve, the solution after it.
+    previous : petsc4py.PETSc.Vec or None
+        The solution before the last (load paths only).
+    targets : list of float
+        Scaled loads of the solutions in (previous, pressure).
+    """
+
+    def __init__(self, problem, keeps_displacement):
+        self.problem = problem
+        self.keeps_displacement = keeps_displacement
+        self.pressure = problem.vec()
+        self.pressure.set(0.0)
+        self.previous = None
+        self.targets = []
+        # K p of the solutions in targets, K p of the start, every Vec made for them.
+        self.displacements, self.start_displacement, self.pool = [], None, []
+        self.last_separation = None
+
+    @property
+    def unknown(self):
+        return self.pressure
+
+    def start(self, control, target, start=None):
+        """Put the start of a solve at ``target`` in :attr:`unknown`; the :class:`Guess` of the backend.
+
+        Under load control the start is the load-path predictor (:meth:`load_start`) and the backend may stop
+        unconfirmed (the facade certifies every result afresh); under displacement control the previous
+        solution is the start. ``start`` names another start ('uniform': the uniform load).
+        """
+        from ..solvers.protocol import Guess
+
+        if start not in (None, "uniform"):
+            raise ParameterError("start", f"the start of the contact problem is 'uniform' or the previous solution, "
+                                          f"got '{start}'")
+        if start == "uniform":
+            self.targets, self.displacements = [], []
+            self.pressure.set(0.0)
+        if control == "displacement":
+            return Guess()
+        return Guess(separation=self.last_separation, displacement=self.load_start(target), confirm=False)
+
+
+    def load_start(self, target):
+        """Put the start of a load-controlled solve at ``target`` in :attr:`pressure`; its K p if known.
+
+        After two load-controlled solves, the pressure is extrapolated
+        linearly in the load from them (step ratio capped at 2), projected onto p >= 0; it
+        is then scaled to the new mean pressure. After one, that solution is
+        scaled; with none, the start is uniform.
+
+        Returns K p of the start when it follows from the kept K p of the previous solutions (the
+        same combination, exact when the projection changed nothing; K of a uniform pressure is 0),
+        else None. Other choices tried along the 95-step history (quadratic or cubic extrapolation in the
+        load, linear or quadratic in log or sqrt of the load, the predicted gap's entering nodes) started
+        no closer: see studies/load_history.py.
+        """
+        displacements = self.displacements
+        known = self.keeps_displacement and len(displacements) == len(self.targets)
+        if known and self.start_displacement is None:
+            self.start_displacement = self.problem.vec()
+            self.pool.append(self.start_displacement)
+        if self.targets and self.previous is None:
+            self.previous = self.problem.vec()
+        if len(self.targets) == 2:
+            older, newer = self.targets
+            if newer != older:
+                ratio = min((target - newer) / (newer - older), 2.0)
+                # previous <- (1 + ratio) p_newer - ratio p_older, then swap: the start in pressure,
+                # the newer solution kept in previous for the next step.
+                self.previous.axpby(1.0 + ratio, -ratio, self.pressure)
+                self.pressure, self.previous = self.previous, self.pressure
+                local = self.problem.local(self.pressure)
+                clipped, = allsum(self.problem.mpi, [np.count_nonzero(local < 0.0)])
+                np.maximum(local, 0.0, out=local)
+                if known:
+                    known = clipped == 0
+                    displacements[1].copy(self.start_displacement)
+                    self.start_displacement.scale(1.0 + ratio)
+                    self.start_displacement.axpy(-ratio, displacements[0])
+            elif known:
+                displacements[1].copy(self.start_displacement)
+        elif self.targets:
+            self.pressure.copy(self.previous)
+            if known:
+                displacements[0].copy(self.start_displacement)
+        elif known:
+            self.start_displacement.set(0.0)
+        mean_p = self.pressure.sum() / self.problem.n
+        if mean_p > 0:
+            self.pressure.scale(target / mean_p)
+            if known:
+                self.start_displacement.scale(target / mean_p)
+        else:
+            self.pressure.set(target)
+            if known:
+                self.start_displacement.set(0.0)
+        return self.start_displacement if known else None
+
+    def record(self, control, target, outcome, gap):
+        """Remember the certified solution in :attr:`pressure` at ``target``, and its separation.
+
+        ``gap`` is its fresh gap (the certificate's): K p = g - d + h is kept when ``keeps_displacement``
+        (load control).
+        """
+        self.last_separation = separation = outcome.separation
+        target = target if control == "load" else None
+        self.targets = (self.targets + [target])[-2:] if target is not None else []
+        if target is None or not self.keeps_displacement:
+            self.displacements = []
+            return
+        if len(self.displacements) == 2:
+            kept = self.displacements.pop(0)
+        else:
+            kept = self.problem.vec()
+            self.pool.append(kept)
+        kept.waxpy(1.0, self.problem.heights, gap)
+        kept.shift(-separation)
+        self.displacements.append(kept)
+
+    def destroy(self):
+        self.pressure.destroy()
+        if self.previous is not None:
+            self.previous.destroy()
+        for v in self.pool:
+            v.destroy()
+
+
+class GapContinuation:
+    """The gap of an adhesive problem and its starts along a path of mean gaps.
+
+    The first solve starts from the rigid gap max(gbar - h, 0) shifted to mean gbar; later ones from the
+    previous gap shifted by the change of gbar (both projected onto g >= 0, mean gbar by the solver). Along a
+    retraction, keep each step below the range of the law: a longer one starts the solver with the whole
+    contact opened beyond the law's reach, and the path snaps off early. ``start="rigid"`` or ``"uniform"``
+    (g = gbar everywhere, the start of Tamaas' solver) forces a start: the local minimum a non-convex problem
+    reaches depends on it.
+    """
+
+    STARTS = (None, "rigid", "uniform")
+
+    def __init__(self, problem):
+        self.problem = problem
+        self.unknown = problem.vec()
+        self.started = False
+
+    def start(self, control, target, start=None):
+        from ..solvers.protocol import Guess
+
+        if start not in self.STARTS:
+            raise ParameterError("start", f"the start is 'rigid' or 'uniform', got '{start}'")
+        problem = self.problem
+        g = problem.local(self.unknown)
+        if start == "uniform":
+            g[...] = target
+        elif start == "rigid" or not self.started:
+            g[...] = target - problem.local(problem.heights, readonly=True)
+        else:
+            current, = allsum(problem.mpi, [g.sum()])
+            g += target - current / problem.n
+        self.started = True
+        return Guess()
+
+    def record(self, control, target, outcome, work):
+        """Nothing to remember: the gap itself is the next start."""
+
+    def destroy(self):
+        self.unknown.destroy()

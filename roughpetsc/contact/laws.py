@@ -1,0 +1,196 @@
+"""Adhesive interaction laws: an energy per unit area phi(g) of the local gap g >= 0.
+
+The adhesive contact problem adds ``sum phi(g) dA`` to the elastic energy (chapter 6 of the
+dissertation treats the same laws in its closed-form models): ``phi(0) = -w`` with ``w`` the work of
+adhesion (energy per unit area, pressure x length units) and ``phi -> 0`` beyond the range of the
+law. ``force(g) = phi'(g) >= 0`` is the magnitude of the attractive (tensile) stress the law exerts at
+gap g; ``curvature(g) = phi''(g)``.
+
+Laws
+----
+``Dugdale(work, stress)``
+    The Maugis-Dugdale law: a constant tensile stress sigma0 up to the range h0 = w / sigma0,
+    ``phi = -w + sigma0 g`` for g < h0, 0 beyond (Maugis, J. Colloid Interface Sci. 150, 1992).
+``Exponential(work, range_)``
+    ``phi = -w exp(-g / rho)``: peak stress w / rho at contact (Rey, Anciaux and Molinari, Comput. Mech.
+    60, 2017 use it for rough surfaces).
+"""
+
+import math
+
+import numpy as np
+
+from ..errors import ParameterError
+
+LAWS = ("none", "dugdale", "exponential")
+
+
+def _positive(name, value, what):
+    """``value`` as a float; :class:`ParameterError` naming ``name`` if it is missing (None), or not positive and
+    finite (quoting it)."""
+    if value is None:
+        raise ParameterError(name, f"the {what} is missing: give a positive value")
+    if not (value > 0 and math.isfinite(value)):
+        raise ParameterError(name, f"the {what} must be positive and finite, got {value:g}")
+    return float(value)
+
+
+class Dugdale:
+    """The Maugis-Dugdale law: tensile stress ``stress`` (pressure units) up to the range w / stress."""
+
+    name = "dugdale"
+    curved = False  # phi'' = 0 wherever it exists
+
+    def __init__(self, work, stress):
+        self.work = _positive("adhesion_work", work, "work of adhesion")
+        self.stress = _positive("adhesion_stress", stress, "Dugdale stress")
+        self.range = self.work / self.stress
+
+    @property
+    def peak_stress(self):
+        return self.stress
+
+    def scaled(self, length, pressure):
+        """The same law in units where lengths are ``length`` and pressures ``pressure``."""
+        return Dugdale(self.work / (length * pressure), self.stress / pressure)
+
+    def energy(self, gap):
+        return np.minimum(self.stress * gap - self.work, 0.0)
+
+    def energy_change(self, gap, trial):
+        """``phi(trial) - phi(gap)`` node by node, as sigma0 (min(trial, h0) - min(gap, h0)) (no w to cancel)."""
+        return self.energy_changes_from(gap)(trial, np.empty_like(trial))
+
+    def energy_changes_from(self, gap, scratch=None):
+        """``change(trial, out)``: :meth:`energy_change` from ``gap`` written to ``out`` (which may be ``trial``),
+        the part of ``gap`` made once (a line search calls it for every trial step); ``scratch``: two arrays
+        of gap's shape it may keep (allocated if None)."""
+        base = np.minimum(gap, self.range, out=None if scratch is None else scratch[0])
+
+        def change(trial, out):
+            np.minimum(trial, self.range, out=out)
+            out -= base
+            out *= self.stress
+            return out
+
+        return change
+
+    def force(self, gap, out=None):
+        return np.multiply(np.less(gap, self.range), self.stress, out=out)
+
+    def curvature(self, gap, out=None):
+        if out is None:
+            return np.zeros_like(gap)
+        out[...] = 0.0
+        return out
+
+    def describe(self):
+        return f"Dugdale law: w = {self.work:.6g}, sigma0 = {self.stress:.6g}, range h0 = {self.range:.6g}"
+
+
+class Exponential:
+    """``phi = -w exp(-g / rho)``: work ``work``, range ``range_`` (length units), peak stress w / rho."""
+
+    name = "exponential"
+    curved = True
+
+    def __init__(self, work, range_):
+        self.work = _positive("adhesion_work", work, "work of adhesion")
+        self.range = _positive("adhesion_range", range_, "range of adhesion")
+
+    @property
+    def peak_stress(self):
+        return self.work / self.range
+
+    def scaled(self, length, pressure):
+        return Exponential(self.work / (length * pressure), self.range / length)
+
+    def energy(self, gap):
+        return -self.work * np.exp(-gap / self.range)
+
+    def energy_change(self, gap, trial):
+        """``phi(trial) - phi(gap)`` node by node, in a form that does not cancel for close gaps.
+
+        Below g = 0 (a line search's trial before its projection) phi is continued by its tangent at 0,
+        as the Dugdale law continues itself, so that a long step cannot gain unbounded energy.
+        """
+        return self.energy_changes_from(gap)(trial, np.empty_like(trial))
+
+    def energy_changes_from(self, gap, scratch=None):
+        """``change(trial, out)``: :meth:`energy_change` from ``gap`` written to ``out`` (which may be ``trial``);
+        ``scratch``: three arrays of gap's shape it keeps (allocated if None).
+
+        phi(t) - phi(g) = s phi(min(g, t)) expm1(-|g - t| / rho), s = 1 for t >= g and -1 below: one
+        expm1 that does not cancel for close gaps, and exponents that are never positive, so that no
+        range however short overflows (exp(-g / rho) may underflow to 0, which is phi's value then).
+        """
+        difference, smaller, factor = scratch if scratch is not None else (
+            np.empty_like(gap), np.empty_like(gap), np.empty_like(gap))
+
+        def change(trial, out):  # out may be trial
+            np.maximum(trial, 0.0, out=smaller)
+            np.subtract(trial, smaller, out=out)  # the part of the trial below 0, on phi's tangent there
+            out *= self.peak_stress
+            np.subtract(gap, smaller, out=difference)            # g - t
+            np.minimum(smaller, gap, out=smaller)
+            np.multiply(smaller, -1.0 / self.range, out=smaller)
+            np.exp(smaller, out=smaller)
+            np.multiply(smaller, -self.work, out=smaller)        # phi(min(g, t))
+            np.abs(difference, out=factor)
+            np.multiply(factor, -1.0 / self.range, out=factor)
+            np.expm1(factor, out=factor)                         # expm1(-|g - t| / rho)
+            np.copysign(factor, difference, out=factor)          # s expm1(...), as expm1 <= 0: the sign of g - t
+            np.multiply(factor, smaller, out=factor)
+            out += factor
+            return out
+
+        return change
+
+    def force(self, gap, out=None):
+        out = np.divide(gap, -self.range, out=out)
+        np.exp(out, out=out)
+        out *= self.peak_stress
+        return out
+
+    def curvature(self, gap, out=None):
+        out = np.multiply(gap, -1.0 / self.range, out=out)
+        np.exp(out, out=out)
+        out *= -self.peak_stress / self.range
+        return out
+
+    def describe(self):
+        return (f"exponential law: w = {self.work:.6g}, range rho = {self.range:.6g}, "
+                f"peak stress w/rho = {self.peak_stress:.6g}")
+
+
+def make_law(kind, work=None, stress=None, range_=None):
+    """The law ``kind`` ("none", "dugdale", "exponential") from its parameters (None for "none").
+
+    Dugdale takes ``stress`` (sigma0) or ``range_`` (h0, then sigma0 = w / h0); exponential takes ``range_``.
+    """
+    if kind == "none":
+        return None
+    if kind == "dugdale":
+        if stress is not None and range_ is not None:
+            raise ParameterError("adhesion_range", "give the Dugdale stress or the range, not both (h0 = w / sigma0)")
+        if stress is None and range_ is None:
+            raise ParameterError("adhesion_stress", "the Dugdale law needs its stress sigma0 or its range h0 = w / "
+                                                    "sigma0: give one")
+        if range_ is not None:
+            stress = _positive("adhesion_work", work, "work of adhesion") / \
+                _positive("adhesion_range", range_, "range of adhesion")
+        return Dugdale(work, stress)
+    if kind == "exponential":
+        return Exponential(work, range_)
+    raise ParameterError("adhesion", f"the adhesion law is one of {', '.join(LAWS)}, got '{kind}'")
+
+
+def tabor_parameter(law, radius, E_star):
+    """Tabor's parameter mu = (R w^2 / (E*^2 z0^3))^(1/3) with z0 the law's range (dimensionless).
+
+    Large mu: the JKR limit (short-range adhesion, compliant bodies); small mu: the DMT limit. For
+    the Dugdale law Maugis's lambda (:func:`roughpetsc.models.sphere_adhesion.maugis_parameter`) is
+    the usual form.
+    """
+    return (radius * law.work ** 2 / (E_star ** 2 * law.range ** 3)) ** (1.0 / 3.0)
+

@@ -1,0 +1,87 @@
+"""MPI bookkeeping every layer shares: reductions of local sums, the split of grid rows over ranks, row exchange.
+
+A field of the grid is distributed by rows (PETSc's ownership ranges, the slab of the FFT); every rank
+owns at least one row.
+"""
+
+import numpy as np
+
+from .errors import ParameterError
+
+
+def _allreduce(comm, values, operation):
+    local = np.asarray(values, dtype=np.float64)
+    if comm.Get_size() == 1:
+        return local
+    from mpi4py import MPI
+
+    total = np.empty_like(local)
+    comm.Allreduce(local, total, op=getattr(MPI, operation))
+    return total
+
+
+def allsum(comm, values):
+    """Global sums of a sequence of local floats in one reduction (mpi4py communicator)."""
+    return _allreduce(comm, values, "SUM")
+
+
+def allmin(comm, values):
+    """Global minima of a sequence of local floats in one reduction."""
+    return _allreduce(comm, values, "MIN")
+
+
+def allmax(comm, values):
+    """Global maxima of a sequence of local floats in one reduction."""
+    return _allreduce(comm, values, "MAX")
+
+
+def block_split(count, size):
+    """Balanced blocks of ``count`` items over ``size`` ranks, the extra items on the first ranks.
+
+    The same split as PETSc's ``PetscSplitOwnership`` (``PETSC_DECIDE``):
+    rank ``r`` gets ``count // size + (r < count % size)`` items.
+
+    Returns
+    -------
+    starts, counts : ndarray of int, shape (size,)
+        First item and number of items of each rank.
+    """
+    counts = np.full(size, count // size, dtype=int)
+    counts[: count % size] += 1
+    starts = np.concatenate(([0], np.cumsum(counts)[:-1])).astype(int)
+    return starts, counts
+
+
+def row_split(n0, size):
+    """The real-space row blocks of a grid of ``n0`` rows on ``size`` ranks: ``(starts, counts)``.
+
+    Raises
+    ------
+    ParameterError
+        (parameter ``n0``) if a rank would own no row (more ranks than rows).
+    """
+    if n0 < size:
+        raise ParameterError("n0", f"the grid has {n0} row(s), fewer than the {size} MPI ranks "
+                                   "that share them (every rank needs at least one row)")
+    return block_split(n0, size)
+
+
+def gather_rows(comm, local):
+    """The whole array on rank 0 (None elsewhere) from each rank's block of rows (mpi4py ``comm``)."""
+    if comm.Get_size() == 1:
+        return np.array(local)
+    parts = comm.gather(np.ascontiguousarray(local), root=0)
+    return np.concatenate(parts, axis=0) if comm.Get_rank() == 0 else None
+
+
+def next_rank_first_row(comm, rows):
+    """The first row of the next rank (periodically): the neighbour below this rank's last row.
+
+    Every rank owns at least one row (:func:`roughpetsc.slab.row_split`), however unevenly they are shared.
+    """
+    size, rank = comm.Get_size(), comm.Get_rank()
+    if size == 1:
+        return rows[0]
+    received = np.empty_like(rows[0])
+    comm.Sendrecv(np.ascontiguousarray(rows[0]), dest=(rank - 1) % size, recvbuf=received, source=(rank + 1) % size)
+    return received

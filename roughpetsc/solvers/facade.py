@@ -1,0 +1,142 @@
+"""The solver facade: one backend for a problem of any kind, warm starts along loads, every result certified.
+
+:class:`Solver` resolves the backend by the problem's kind and a name through
+:mod:`~roughpetsc.solvers.registry`, holds the unknown in the problem's continuation (which starts each
+solve from the previous solutions), and turns the backend's :class:`~roughpetsc.solvers.protocol.Outcome`
+into a :class:`~roughpetsc.contact.Result` through the problem's certificate, computed afresh.
+"""
+
+import time
+
+import numpy as np
+
+from ..errors import ParameterError
+from .options import SolverOptions
+from .protocol import BackendSettings, Guess, Outcome
+from .registry import make_backend
+from .stopping import StoppingRule, max_seconds
+
+
+class Solver:
+    """One solver for a problem, chosen by name; solves loads in order with warm starts.
+
+    Parameters
+    ----------
+    problem : ContactProblem or AdhesiveProblem
+        Any problem of the protocol of :mod:`roughpetsc.solvers.protocol`.
+    control : "load" or "displacement"
+        One of ``problem.controls``.
+    tao_type : str or None
+        A registered name for the problem's kind (:func:`~roughpetsc.solvers.registry.backend_names`);
+        None reads ``-tao_type`` under ``prefix`` (from ``options`` or the command line), and without one
+        the kind's default: Polonsky-Keer for the contact problem, the projected CG on the gap for the
+        adhesive one.
+    rtol : float
+        Stopping tolerance on the natural KKT residual (and the error of the prescribed load or mean gap).
+    prefix : str or None
+        Options prefix of the solver's TAO objects and of its own options (``-bound_pc``, ``-pk_pc``,
+        ``-solve_max_time``, ``-tao_max_it``, ...); None reads them unprefixed, as the command line gives them.
+    options : dict or None
+        Options for this solver alone (``{"tao_type": "bqnls", "tao_max_it": 500}``, names without dash or
+        prefix): set under the prefix while the solver lives (:class:`~roughpetsc.solvers.options.SolverOptions`;
+        without a prefix they get one of their own). An option given here that nothing reads is an error.
+
+    Attributes
+    ----------
+    name : str
+        The solver's name in results: the TAO type, ``rootfind(<type>)``, ``almm``, ``pk(<pc>)``, ``gapcg``.
+    backend :
+        The backend object (:mod:`roughpetsc.solvers.protocol`).
+    """
+
+    def __init__(self, problem, control, tao_type=None, rtol=1e-8, prefix=None, options=None):
+        if control not in problem.controls:
+            raise ParameterError("control", f"the {problem.kind} problem is solved under {' or '.join(problem.controls)} "
+                                            f"control, not {control}")
+        self.problem = problem
+        self.control = control
+        self.rtol = rtol
+        self.options = SolverOptions(prefix, options)
+        try:
+            prefix = self.options.prefix
+            if tao_type is None:
+                tao_type = self.options.get("tao_type") or None
+            settings = BackendSettings(StoppingRule(rtol, max_seconds(prefix)), prefix)
+            self.backend = make_backend(problem, control, tao_type, settings)
+        except BaseException:
+            self.options.destroy()
+            raise
+        self.name = self.backend.name
+        keeps_displacement = control == "load" and self.backend.keeps_displacement
+        self.path = problem.continuation(keeps_displacement)
+        self.work = problem.vec()  # the certificate's gradient: the gap (contact), S (g + h) (adhesive)
+        self.last = None
+        unused = self.options.unused()
+        if unused:
+            self.destroy()
+            raise ParameterError("options", f"option(s) not used by the solver {self.name}: "
+                                            + ", ".join(unused))
+
+    @property
+    def unknown(self):
+        """The unknown Vec (scaled) of the last solve, and the start of the next."""
+        return self.path.unknown
+
+    # The contact problem's unknown is the pressure.
+    pressure = unknown
+
+    @property
+    def tao(self):
+        """The backend's TAO object (the inner one of the root find): for monitors and views."""
+        return self.backend.tao
+
+    def unusable_options(self):
+        """Options given that the backend read but cannot use (Polonsky-Keer has no line search or KSP)."""
+        return self.backend.unusable_options()
+
+    def solve(self, pbar=None, pstar=None, gbar=None, start=None):
+        """Solve one load; the previous solution is the start. Returns a :class:`~roughpetsc.contact.Result`.
+
+        Give ``pbar`` (mean pressure) or ``pstar`` (= pbar / sqrt(m0^p)) under load control, ``gbar``
+        (the mean gap, which is the rigid separation (3.38) of the dissertation) under displacement
+        control. ``start`` names another start than the previous solution (the continuation's ``start``).
+        """
+        problem = self.problem
+        started = time.perf_counter()
+        applications = problem.operator.applications
+        control = "displacement" if gbar is not None else ("load" if (pbar, pstar) != (None, None) else self.control)
+        if control != self.control:
+            given = "gbar" if gbar is not None else ("pstar" if pstar is not None else "pbar")
+            raise ParameterError(given, f"this solver was made for {self.control} control; {given} prescribes "
+                                        f"{control} control")
+        target = problem.target(control, pbar=pbar, pstar=pstar, gbar=gbar)
+        outcome = problem.exact(target, control, self.path.unknown)
+        if outcome is None:
+            guess = self.path.start(control, target, start)  # may swap the unknown's Vec (the predictor's)
+            outcome = self.backend.solve(target, self.path.unknown, guess)
+        result = self._certify(outcome, target, started, applications)
+        if not outcome.confirmed and not result.converged:
+            # The backend stopped on its updated gradient and the fresh one disagrees: resume, confirming this time.
+            resumed = self.backend.solve(target, self.path.unknown, Guess(separation=outcome.separation))
+            outcome = Outcome(resumed.separation, outcome.iterations + resumed.iterations, resumed.reason,
+                              np.concatenate([outcome.history, resumed.history]))
+            result = self._certify(outcome, target, started, applications)
+        self.path.record(control, target, outcome, self.work)
+        self.last = result
+        return result
+
+    def _certify(self, outcome, target, started, applications):
+        return self.problem.certify(self.path.unknown, self.work, outcome, target, self.control, self.rtol, self.name,
+                                    started, applications)
+
+    def fields(self):
+        """This rank's rows of the pressure and gap of the last solve, in pressure and length units."""
+        return self.problem.fields(self.path.unknown, self.work, self.last)
+
+    def destroy(self):
+        for part in ("backend", "path"):
+            if hasattr(self, part):
+                getattr(self, part).destroy()
+        if hasattr(self, "work"):
+            self.work.destroy()
+        self.options.destroy()

@@ -1,0 +1,159 @@
+"""The Fourier preconditioner of the contact QP on its free (contact) set.
+
+The compliance K has the symbol 1/(pi E* |k|) (the Westergaard operator (3.33)
+of the dissertation), so its condition number on the contact set C grows like
+N. Its inverse symbol pi E* |k|, applied in Fourier space to a residual that
+vanishes off C and restricted to C again, is a cheap approximate inverse of
+K_CC (Vollebregt, J. Comput. Phys. 257, 2014): one FFT pair per application.
+
+``B r = P S P r + w mean_C(r) / lambda_C 1_C`` with ``S`` the inverse symbol,
+``P`` the removal of the mean on C, and ``lambda_C = <1_C, K 1_C> / |C|`` the
+compliance of a uniform pressure on C. The second term preconditions the mean
+on C, which the symbol (whose k = 0 mode is the rigid body) cannot; it is
+dropped under load control, where the mean pressure is fixed. ``B`` is
+symmetric positive definite on C (a sum over two orthogonal subspaces).
+
+Used by Polonsky-Keer (:mod:`roughpetsc.solvers.polonsky_keer`) and, as a Hessian
+preconditioning matrix with a free-set ``createSubMatrix`` and PC type
+``mat``, by TAO's TRON, GPCG and BNK types.
+"""
+
+import numpy as np
+from petsc4py import PETSc
+
+from ..contact import loops
+from ..parallel import allsum
+
+# Weight w of the mean mode. Measured with PK under displacement control on
+# group #1, p* = 0.5, iterations at N = 256 / 512: w = 1: 102 / 123, 4: 59 / 83,
+# 8: 62 / 84, 16: 51 / 68, 32: 88 / 149. The middle of the flat range (on a
+# log scale) is kept, away from the cliff above 16.
+MEAN_MODE_WEIGHT = 8.0
+
+
+class FourierPreconditioner:
+    """``B`` of the module docstring for a :class:`~roughpetsc.contact.ContactProblem`."""
+
+    def __init__(self, problem):
+        self.problem = problem
+        self.indicator = problem.vec()
+        self.response = problem.vec()
+        self._mean_mode = (0.0, 1.0)  # (|C| it was computed for, lambda_C)
+
+    def destroy(self):
+        self.indicator.destroy()
+        self.response.destroy()
+
+    def mean_mode_compliance(self, contact, count):
+        """``lambda_C``, recomputed (one K application) when |C| changed by more than 5 %."""
+        computed_for, compliance = self._mean_mode
+        if abs(count - computed_for) <= 0.05 * count:
+            return compliance
+        problem = self.problem
+        problem.local(self.indicator).ravel()[...] = contact
+        problem.operator.displacement(self.indicator, self.response)
+        energy, = allsum(problem.mpi, [np.dot(problem.local(self.response, readonly=True).ravel(), contact)])
+        # C = every node: the uniform pressure is the rigid mode (K 1 = 0), nothing to precondition.
+        compliance = energy / count if energy > 0 else np.inf
+        self._mean_mode = (count, compliance)
+        return compliance
+
+    @PETSc.Log.EventDecorator("RPFourierPC")  # -log_view: one application of B, its FFT pair included
+    def apply(self, residual, out, contact, count, keep_load, rigid_compliance=np.inf):
+        """``out = B residual`` on local flat arrays; ``residual`` vanishes off the contact set.
+
+        ``contact`` is 1.0 on C and 0.0 elsewhere, ``count`` the global |C|.
+        ``keep_load``: load control; the residual must then have zero mean on
+        C, and the mean-mode term is dropped (directions keep the mean pressure).
+        ``rigid_compliance``: the lambda_C to use when C is every node, where K 1 = 0 (the uniform
+        pressure is the rigid mode); infinite drops the mean mode there, as PK wants.
+        """
+        problem = self.problem
+        operator = problem.operator
+        shape = operator.local_shape
+        if keep_load:
+            # The caller's residual has zero mean on C already (load control): P residual = residual.
+            operator.stiffness(residual.reshape(shape), out.reshape(shape))
+        else:
+            residual_sum, = allsum(problem.mpi, [residual.sum()])
+            residual_mean = residual_sum / count
+            np.multiply(contact, -residual_mean, out=out)
+            out += residual  # P residual, built in out: the FFT pair may run in place
+            operator.stiffness(out.reshape(shape), out.reshape(shape))
+        out_sum, = allsum(problem.mpi, [loops.masked_sum(out, contact)])
+        loops.shift_on(out, contact, out_sum / count, out)
+        if not keep_load:
+            compliance = self.mean_mode_compliance(contact, count)
+            if not np.isfinite(compliance):
+                compliance = rigid_compliance
+            out += MEAN_MODE_WEIGHT * residual_mean / compliance * contact
+
+    # --- as a TAO Hessian preconditioning matrix --------------------------
+    def mat(self):
+        """A python Mat applying ``B`` with C = all nodes; its ``createSubMatrix`` gives ``B`` on a free set.
+
+        Give it to TAO as the Hessian's preconditioning matrix and set the KSP's
+        PC to type ``mat``. Destroy it when done.
+        """
+        n_local = self.problem.operator.local_shape[0] * self.problem.operator.local_shape[1]
+        size = ((n_local, self.problem.n), (n_local, self.problem.n))
+        mat = PETSc.Mat().createPython(size, context=_RestrictedMat(self, None), comm=self.problem.comm)
+        mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        mat.setUp()
+        return mat
+
+
+class _RestrictedMat:
+    """MATPYTHON context: ``B`` on the free set given by an IS of global indices (None: every node)."""
+
+    def __init__(self, preconditioner, free, rigid_compliance=None):
+        self.preconditioner = preconditioner
+        problem = preconditioner.problem
+        self.residual = problem.vec()
+        self.out = problem.vec()
+        start = self.residual.getOwnershipRange()[0]
+        self.contact = np.zeros(self.residual.getLocalSize())
+        if free is None:
+            self.indices = None
+            self.contact[...] = 1.0
+        else:
+            self.indices = free.getIndices() - start
+            self.contact[self.indices] = 1.0
+        self.count, = allsum(problem.mpi, [self.contact.sum()])
+        # With every node free, K is singular (K 1 = 0) and a TAO Newton type shifts it, K + a I: the
+        # mean mode is then preconditioned by 1 / a, or, before any shift, by the compliance of the
+        # longest wavelength, so that B stays positive definite (a singular B broke BNLS/BNTR's CG).
+        grid = problem.scaled_grid  # scaled units: E* = 1
+        self.rigid_compliance = rigid_compliance or max(grid.l0, grid.l1) / np.pi
+
+    def mult(self, mat, x, y):
+        residual = self.residual.getArray()
+        out = self.out.getArray()
+        if self.indices is None:
+            residual[...] = x.getArray(readonly=True)
+        else:
+            residual[...] = 0.0
+            residual[self.indices] = x.getArray(readonly=True)
+        self.preconditioner.apply(residual, out, self.contact, self.count, keep_load=False,
+                                  rigid_compliance=self.rigid_compliance)
+        y.getArray()[...] = out if self.indices is None else out[self.indices]
+
+    def shift(self, mat, a):
+        """TAO's BNK Hessian perturbation (MatShift): the rigid mode of K + a I has compliance 1 / a."""
+        if a > 0:
+            self.rigid_compliance = 1.0 / a
+
+    def createSubMatrix(self, mat, isrow, iscol, submat):
+        context = _RestrictedMat(self.preconditioner, isrow, self.rigid_compliance)
+        if submat is not None:  # MAT_REUSE_MATRIX: same sizes, new free set
+            submat.getPythonContext().destroy(submat)
+            submat.setPythonContext(context)
+            return submat
+        sub = PETSc.Mat().createPython(((isrow.getLocalSize(), isrow.getSize()),) * 2, context=context,
+                                       comm=mat.getComm())
+        sub.setUp()
+        return sub
+
+    def destroy(self, mat):
+        self.residual.destroy()
+        self.out.destroy()

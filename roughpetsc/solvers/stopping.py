@@ -1,0 +1,283 @@
+"""The one stopping rule of every solver backend: tolerance, fresh confirmation, limits, stagnation, best iterate.
+
+Every backend of :mod:`roughpetsc.solvers` (TAO's bound types through their convergence test, Polonsky-Keer
+and the gap CG as TAO ``python`` types, the ALMMs) decides when to stop with a :class:`Watch` on one
+:class:`StoppingRule`:
+
+* converged: the natural KKT residual (docs/conventions.md) and, where a load or a mean gap is prescribed,
+  its error are at most ``rtol``; a backend that updates its gradient instead of computing it afresh
+  must confirm on a fresh one first (the verdict ``CONFIRM``);
+* the iteration limit (``-tao_max_it``, :data:`DEFAULT_MAX_IT` by default), the time limit
+  (``-solve_max_time``) or a request to stop (Ctrl-C, :mod:`roughpetsc.interrupts`), decided
+  collectively so that every rank leaves at the same iteration;
+* stagnation: no new best residual for :data:`STAGNATION_ITERATIONS` iterations (round-off bounds the
+  residual from below; CG then wanders).
+
+A stop short of the tolerance names its reason and the best residual reached (:func:`describe_stop`).
+"""
+
+from dataclasses import dataclass
+import enum
+import time
+
+import numpy as np
+from petsc4py import PETSc
+
+from ..errors import UserError
+
+# The iteration limit every TAO of the solvers starts with (-tao_max_it changes it): the natural-residual
+# test decides, and TAO's own limits (the BNK family stops at 50) would end solves early.
+DEFAULT_MAX_IT = 100000
+# A solve whose residual has not improved on its best for this many iterations is stopped (BQNLS can freeze at
+# a fixed iterate without a verdict of its own; CG wanders at the round-off floor).
+STAGNATION_ITERATIONS = 500
+
+OPTIONS = [
+    ("solve_max_time", 0.0, "stop a solve after this many seconds, reported as DIVERGED_USER (0: no limit)"),
+]
+
+
+def option_name(name, prefix=None):
+    """The option as the user types it: ``-`` + prefix + name."""
+    return f"-{prefix or ''}{name}"
+
+
+def max_seconds(prefix=None):
+    """``-solve_max_time`` under ``prefix``: seconds after which a solve stops (0: no limit)."""
+    seconds = PETSc.Options(prefix).getReal("solve_max_time", 0.0)
+    if not seconds >= 0:
+        raise UserError(f"{option_name('solve_max_time', prefix)} must be a non-negative number of seconds, "
+                        f"got {seconds}")
+    return seconds
+
+
+class History:
+    """Residual history of one solve: iteration, natural residual, operator applications, seconds.
+
+    The problem's ``progress`` callable, if set, is called as ``progress(iteration, natural, seconds)``
+    with every row that any solver records (the command line's progress line on a terminal).
+    """
+
+    def __init__(self, problem):
+        self.operator = problem.operator
+        self.mpi = problem.mpi
+        self.progress = problem.progress
+        self.stop_requested = problem.stop_requested
+        self.start = time.perf_counter()
+        self.rows = []
+
+    def record(self, iteration, natural):
+        seconds = time.perf_counter() - self.start
+        self.rows.append((iteration, natural, self.operator.applications, seconds))
+        if self.progress is not None:
+            self.progress(iteration, natural, seconds)
+
+    def extend(self, rows):
+        """Append the rows of another solve (the inner solves of a root find), numbered on from these."""
+        offset = self.rows[-1][0] + 1 if self.rows else 0
+        self.rows.extend((offset + row[0], *row[1:]) for row in rows)
+
+    def out_of_time(self, max_seconds):
+        """True when ``max_seconds`` (> 0) have passed since the history started (``-solve_max_time``), or
+        when a stop was requested on any rank (the problem's ``stop_requested``, Ctrl-C).
+
+        Collective when ``max_seconds > 0`` or a stop can be requested: rank 0's clock decides for
+        every rank, as ranks whose clocks disagreed at the limit would leave the solve by different
+        iterations and hang, and a request on any rank stops them all.
+        """
+        timed = max_seconds > 0
+        if not timed and self.stop_requested is None:
+            return False
+        expired = timed and time.perf_counter() - self.start > max_seconds
+        asked = self.stop_requested is not None and self.stop_requested()
+        if self.mpi.Get_size() == 1:
+            return expired or asked
+        from mpi4py import MPI
+
+        return bool(self.mpi.allreduce(int((expired and self.mpi.Get_rank() == 0) or asked), op=MPI.MAX))
+
+    def as_array(self):
+        return np.array(self.rows, dtype=np.float64).reshape(-1, 4)
+
+
+@dataclass(frozen=True)
+class StoppingRule:
+    """When a solve stops; one per solver, shared by its backends.
+
+    Attributes
+    ----------
+    rtol : float
+        Tolerance on the natural KKT residual and on the error of the prescribed load or mean gap.
+    max_seconds : float
+        Seconds after which a solve stops (0: no limit), ``-solve_max_time``.
+    stagnation : int
+        Iterations without a new best residual after which a solve stops.
+    """
+
+    rtol: float
+    max_seconds: float = 0.0
+    stagnation: int = STAGNATION_ITERATIONS
+
+    def watch(self, history, max_iterations=DEFAULT_MAX_IT):
+        """A :class:`Watch` of one solve under this rule, recording into ``history``."""
+        return Watch(self, history, max_iterations)
+
+
+class Verdict(enum.Enum):
+    CONTINUE = "continue"
+    CONFIRM = "confirm on a fresh gradient"
+    CONVERGED = "converged"
+    MAX_ITERATIONS = "iteration limit"
+    TIME_LIMIT = "time limit"
+    STAGNATION = "stagnation"
+
+    @property
+    def tao_reason(self):
+        """The TAO converged reason of a final verdict (None while iterating)."""
+        return {Verdict.CONVERGED: PETSc.TAO.Reason.CONVERGED_USER,
+                Verdict.MAX_ITERATIONS: PETSc.TAO.Reason.DIVERGED_MAXITS,
+                Verdict.TIME_LIMIT: PETSc.TAO.Reason.DIVERGED_USER,
+                Verdict.STAGNATION: PETSc.TAO.Reason.DIVERGED_USER}.get(self)
+
+
+class Watch:
+    """One solve under a :class:`StoppingRule`: its history, its best residual, its verdicts.
+
+    Attributes
+    ----------
+    best_natural : float
+        The lowest merit seen: the natural residual, or the larger of it and the load error where a
+        load is prescribed (an iterate with the wrong load is not close to the solution).
+    improved : bool
+        Whether the last :meth:`assess` found a new best (the backend may then keep a copy).
+    stopped_by : str or None
+        ``"time limit"`` or ``"stagnation"`` when the watch ended the solve so.
+    """
+
+    def __init__(self, rule, history, max_iterations=DEFAULT_MAX_IT):
+        self.rule = rule
+        self.history = history
+        self.max_iterations = max_iterations
+        self.best_natural = np.inf
+        self.best_iteration = 0
+        self.improved = False
+        self.stopped_by = None
+
+    def converged(self, natural, load_error=None):
+        rtol = self.rule.rtol
+        return natural <= rtol and (load_error is None or load_error <= rtol)
+
+    def assess(self, iteration, natural, load_error=None, fresh=True, confirm=True):
+        """The verdict on an iterate with this residual (and load error); records it unless it must be confirmed.
+
+        ``fresh``: the residual comes from a freshly computed gradient. A converged residual on an
+        updated one asks for confirmation (``CONFIRM``, nothing recorded) when ``confirm`` is True.
+        """
+        self.improved = False
+        if self.converged(natural, load_error):
+            if not fresh and confirm:
+                return Verdict.CONFIRM
+            self.history.record(iteration, natural)
+            self.best_natural = natural if load_error is None else max(natural, load_error)
+            return Verdict.CONVERGED
+        self.history.record(iteration, natural)
+        merit = natural if load_error is None else max(natural, load_error)
+        if merit < self.best_natural:
+            self.best_natural, self.best_iteration, self.improved = merit, iteration, True
+        if iteration >= self.max_iterations:
+            return Verdict.MAX_ITERATIONS
+        if self.history.out_of_time(self.rule.max_seconds):
+            self.stopped_by = "time limit"
+            return Verdict.TIME_LIMIT
+        if iteration - self.best_iteration >= self.rule.stagnation:
+            self.stopped_by = "stagnation"
+            return Verdict.STAGNATION
+        return Verdict.CONTINUE
+
+    def restart(self, iteration):
+        """A backend restarts from its best iterate at ``iteration``: stagnation counts afresh, the best stays."""
+        self.best_iteration, self.stopped_by = iteration, None
+
+
+class ConvergenceTest:
+    """The :class:`Watch` as a TAO convergence test (``tao.setConvergenceTest``).
+
+    ``evaluate(tao)`` returns ``(natural, load_error, fresh)`` of the current iterate (load_error None
+    without a prescribed load). TAO's own verdict on its own residual (which differs by type) never ends
+    a solve early: a "converged" of TAO with a larger natural residual is turned back into "continue"
+    while iterations remain. ``keep_best(x)``, if given, is called with each new best iterate.
+    ``iteration_offset`` numbers the iterations of a solve restarted by its backend on from the first.
+    """
+
+    def __init__(self, watch, evaluate, keep_best=None, confirm=True):
+        self.watch = watch
+        self.evaluate = evaluate
+        self.keep_best = keep_best
+        self.confirm = confirm
+        self.iteration_offset = 0
+        self.verdict = Verdict.CONTINUE
+
+    @property
+    def best_natural(self):
+        return self.watch.best_natural
+
+    @property
+    def stopped_by(self):
+        return self.watch.stopped_by
+
+    def __call__(self, tao):
+        natural, load_error, fresh = self.evaluate(tao)
+        iteration = tao.getIterationNumber()
+        self.watch.max_iterations = tao.getMaximumIterations() + self.iteration_offset
+        verdict = self.verdict = self.watch.assess(iteration + self.iteration_offset, natural, load_error, fresh,
+                                                   self.confirm)
+        if verdict is Verdict.CONFIRM:
+            return PETSc.TAO.Reason.CONTINUE_ITERATING
+        if self.watch.improved and self.keep_best is not None:
+            self.keep_best(tao.getSolution())
+        if verdict is not Verdict.CONTINUE:
+            return verdict.tao_reason
+        if tao.getConvergedReason() > 0 and iteration < tao.getMaximumIterations():
+            return PETSc.TAO.Reason.CONTINUE_ITERATING
+        return None
+
+
+def check_convergence(tao):
+    """Run the convergence test set on ``tao`` (a TAO of type ``python`` calls it once per iteration).
+
+    petsc4py 3.18 wraps neither ``TaoConverged`` nor ``Tao.checkConverged``; this calls the Python test
+    that ``tao.setConvergenceTest`` holds as petsc4py would, setting the reason it returns.
+    """
+    test, args, kwargs = tao.getConvergenceTest()
+    reason = test(tao, *(args or ()), **(kwargs or {}))
+    if reason is not None:
+        tao.setConvergedReason(reason)
+    return tao.getConvergedReason()
+
+
+def reason_name(reason):
+    """PETSc's name of a TAO converged reason."""
+    for name, value in vars(PETSc.TAO.Reason).items():
+        if not name.startswith("_") and value == reason and name not in ("ITERATING", "CONVERGED_ITERATING"):
+            return name
+    return str(reason)
+
+
+def describe_stop(reason, watch, restarts=0, load_control=False, note=None):
+    """PETSc's reason name with what the watch stopped for and, short of the tolerance, the best residual.
+
+    ``reason`` is a TAO converged reason (int) or a reason name (str). A solve that ends short of the
+    tolerance says which residual it reached (and, after restarts, that this is the floor that restarting
+    could not lower), so a bare DIVERGED_LS_FAILURE is never the whole story. ``note`` says why a backend
+    gave up by itself (a failed line search of its own).
+    """
+    name = reason if isinstance(reason, str) else reason_name(reason)
+    notes = [watch.stopped_by] if watch.stopped_by and name == "DIVERGED_USER" else []
+    if note:
+        notes.insert(0, note)
+    if not name.startswith("CONVERGED") and np.isfinite(watch.best_natural):
+        measure = "of natural residual, load error" if load_control else "natural residual"
+        notes.append(f"best {measure} {watch.best_natural:.2g}")
+        if restarts:
+            notes.append(f"floor after {restarts} restart{'s' * (restarts > 1)}")
+    return f"{name} ({', '.join(notes)})" if notes else name

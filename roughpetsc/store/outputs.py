@@ -1,0 +1,242 @@
+"""Result files: checks of output paths, atomic replacement, JSON, versions and provenance.
+
+Files are written by rank 0 to a temporary name in the same folder and renamed
+at the end (:class:`atomic_path`), so a failed or killed run leaves no half-written
+file. HDF5 files are written by :mod:`roughpetsc.store`.
+"""
+
+import json
+import os
+import re
+import sys
+import tempfile
+
+import numpy as np
+
+from ..errors import UserError
+
+
+def versions():
+    """Versions of roughpetsc and of the stack it ran on."""
+    from petsc4py import PETSc
+    import mpi4py
+    import petsc4py
+    import scipy
+
+    from .. import __version__
+
+    found = {
+        "roughpetsc": __version__,
+        "petsc": ".".join(str(v) for v in PETSc.Sys.getVersion()),
+        "petsc4py": petsc4py.__version__,
+        "mpi4py": mpi4py.__version__,
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "python": sys.version.split()[0],
+    }
+    for module in ("pyfftw", "mpi4py_fft", "h5py"):
+        try:
+            found[module] = __import__(module).__version__
+        except (ImportError, AttributeError):
+            pass
+    return found
+
+
+def provenance():
+    """Command line, options database and versions of this run."""
+    from petsc4py import PETSc
+
+    return {"command": " ".join(sys.argv), "options": dict(PETSc.Options().getAll()), "versions": versions()}
+
+
+def check_writable(path, option):
+    """Fail early, naming the option, if a file cannot be written at ``path``.
+
+    Refused: a folder, a folder that does not exist or takes no new file (tried
+    by creating one, which also catches read-only file systems and root), an
+    existing file without write permission.
+    """
+    if os.path.isdir(path):
+        raise UserError(f"-{option} {path}: is a folder; give a file name")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise UserError(f"-{option} {path}: the folder {folder} does not exist")
+    if os.path.exists(path) and not os.access(path, os.W_OK):
+        raise UserError(f"-{option} {path}: the file is not writable")
+    try:
+        handle, trial = tempfile.mkstemp(prefix=".tmp-", dir=folder)
+    except OSError as error:
+        raise UserError(f"-{option} {path}: cannot create a file in {folder} ({error.strerror})") from None
+    os.close(handle)
+    os.remove(trial)
+
+
+def _same_file(a, b):
+    if os.path.exists(a) and os.path.exists(b):
+        return os.path.samefile(a, b)
+    return os.path.realpath(a) == os.path.realpath(b)
+
+
+def check_outputs(outputs, overwrite=False, inputs=(), may_exist=()):
+    """Refuse, before any work, outputs that would lose a file or cannot be written.
+
+    Parameters
+    ----------
+    outputs : list of (option, path)
+        The files a run will write; empty paths are skipped.
+    overwrite : bool
+        ``-overwrite``: an existing output file may be replaced.
+    inputs : list of (option, path)
+        Files the run reads: never an output, even with ``-overwrite``.
+    may_exist : iterable of option names
+        Outputs that are meant to exist already (a file to resume).
+
+    Raises :class:`UserError` naming the option and the file.
+    """
+    written = []
+    for option, path in outputs:
+        if not path:
+            continue
+        check_writable(path, option)
+        for input_option, input_path in inputs:
+            if input_path and _same_file(path, input_path):
+                raise UserError(f"-{option} {path}: is the input file of -{input_option}; write elsewhere")
+        for other_option, other_path in written:
+            if _same_file(path, other_path):
+                raise UserError(f"-{option} and -{other_option} name the same file {path}")
+        written.append((option, path))
+        if os.path.exists(path) and not overwrite and option not in may_exist:
+            raise UserError(f"-{option} {path}: the file exists; give -overwrite to replace it")
+
+
+def check_figure_format(path, option):
+    """Raise :class:`UserError` naming ``option`` unless matplotlib writes the format of ``path``'s suffix."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    suffix = os.path.splitext(path)[1].lower().lstrip(".")
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if suffix not in formats:
+        raise UserError(f"-{option} {path}: unknown figure format '{suffix}' (one of {', '.join(sorted(formats))})")
+
+
+def on_root(comm, action, *args):
+    """Run ``action(*args)`` on rank 0 only; its :class:`UserError` is raised on every rank.
+
+    What only rank 0 does (checking or writing files) must not fail there
+    alone: the other ranks would wait for ever in their next collective call.
+    The error message is broadcast, so every rank raises the same error (and
+    all ranks leave together). Returns the result on rank 0, None elsewhere.
+    """
+    result, message = None, None
+    if comm is None or comm.Get_rank() == 0:
+        try:
+            result = action(*args)
+        except UserError as error:
+            message = str(error)
+    if comm is not None and comm.Get_size() > 1:
+        message = comm.bcast(message, root=0)
+    if message is not None:
+        raise UserError(message)
+    return result
+
+
+def file_mode():
+    """The mode of a newly created file, ``0o666`` less the umask (0644 under the usual umask 022)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+class atomic_path:
+    """Context manager giving a temporary path (same folder, same suffix) that replaces ``path`` on success only.
+
+    The file gets the mode of any new file (:func:`file_mode`; mkstemp's would
+    be 0600). ``durable``: fsync the file and its folder, so that a crash right
+    after leaves the old or the new file, whole. A failure to write raises
+    :class:`UserError` naming ``path``.
+    """
+
+    def __init__(self, path, durable=False):
+        self.path = path
+        self.durable = durable
+        folder = os.path.dirname(os.path.abspath(path))
+        try:
+            handle, self.temporary = tempfile.mkstemp(prefix=".tmp-", suffix=os.path.basename(path), dir=folder)
+        except OSError as error:
+            raise UserError(f"cannot write {path}: {_os_reason(error)}") from None
+        os.close(handle)
+
+    def __enter__(self):
+        return self.temporary
+
+    def __exit__(self, kind, value, traceback):
+        if kind is None:
+            try:
+                os.chmod(self.temporary, file_mode())
+                if self.durable:
+                    _fsync(self.temporary)
+                os.replace(self.temporary, self.path)
+                if self.durable:
+                    _fsync(os.path.dirname(os.path.abspath(self.path)))
+                return False
+            except OSError as error:
+                kind, value = type(error), error
+        if os.path.exists(self.temporary):
+            os.remove(self.temporary)
+        if issubclass(kind, OSError):  # disk full, permissions changed under the run, ...
+            raise UserError(f"cannot write {self.path}: {_os_reason(value)}") from None
+        return False
+
+
+def _os_reason(error):
+    """The system's words for an OSError, also when HDF5 wrapped them in its own long message."""
+    found = re.search(r"error message = '([^']+)'", str(error))
+    if found:
+        return found.group(1)
+    return error.strerror or str(error).splitlines()[0]
+
+
+def remove_stale_temporaries(path):
+    """Delete the temporaries of :class:`atomic_path` for ``path`` that a killed run left behind.
+
+    Call only where no other run may be writing ``path`` (a resumed ensemble or load path).
+    """
+    folder = os.path.dirname(os.path.abspath(path))
+    suffix = os.path.basename(path)
+    for name in os.listdir(folder):
+        if name.startswith(".tmp-") and name.endswith(suffix) and len(name) > len(".tmp-") + len(suffix):
+            try:
+                os.remove(os.path.join(folder, name))
+            except OSError:
+                pass
+
+
+def _fsync(path):
+    handle = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(handle)
+    except OSError:  # some file systems cannot fsync a folder
+        pass
+    finally:
+        os.close(handle)
+
+
+def jsonable(value):
+    """``value`` with numpy arrays and scalars as Python lists and numbers, non-finite floats as None (JSON null)."""
+    if isinstance(value, dict):
+        return {k: jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [jsonable(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value
+
+
+def write_json(path, data):
+    """Write ``data`` as indented JSON, atomically (the one JSON writer of every mode)."""
+    with atomic_path(path) as temporary:
+        with open(temporary, "w") as f:
+            json.dump(jsonable(data), f, indent=2)
+            f.write("\n")

@@ -1,0 +1,169 @@
+"""The record of a solve-mode run as its load steps finish: what ``-output``, ``-output_fields`` and ``-resume`` keep.
+
+A load path is written to its HDF5 file after its steps (atomically, see
+:mod:`roughpetsc.store`; the layout is :mod:`roughpetsc.store.load_path`), so a run
+interrupted by Ctrl-C, a batch time limit or a step that ran out of
+``-solve_max_time`` keeps its finished steps, and ``-resume`` continues it: the
+steps recorded for the same problem and the same loads are taken from the file,
+the next load starts from the last saved pressure field.
+"""
+
+import time
+
+import numpy as np
+
+from . import outputs as io
+from ..errors import UserError
+from . import path_file as load_path
+
+OUTPUT_FIELDS = ("all", "last", "none")
+
+# Summary entries that must agree for -resume to take steps from a file.
+RESUME_KEYS = ("grid", "length", "E_star", "solver", "control", "kkt_rtol", "boundary", "hardness")
+
+
+class PathRecord:
+    """The steps of a load path as they finish, kept on rank 0 for the output files.
+
+    Parameters
+    ----------
+    summary : dict
+        Everything but ``steps`` of the JSON summary (JSON-ready).
+    heights : ndarray (n0, n1)
+        The whole surface, length units.
+    keep : one of OUTPUT_FIELDS
+        ``-output_fields``: pressure and gap of every step, of the last step, or none.
+    first_row, local_rows : int or None
+        None: the fields given to :meth:`add` are whole (rank 0). Else they are this rank's
+        ``local_rows`` rows from ``first_row`` on, and every rank writes its rows of the file
+        (:meth:`write` with ``comm``).
+    """
+
+    def __init__(self, summary, heights, keep, first_row=None, local_rows=None):
+        self.first_row, self.local_rows = first_row, local_rows
+        self.summary = summary
+        self.heights = heights
+        self.keep = keep
+        self.steps = []  # JSON-ready summaries of the finished steps
+        self.histories = {}
+        self.step_fields = {}  # step index -> {"pressure": ..., "gap": ...} (keep == "all")
+        self.last_fields = {}
+        self.stresses = []  # roughpetsc.stresses.DepthStresses of the last step (-stress_depths)
+        self.write_seconds = 0.0
+        self.written_at = -np.inf
+        self.written = 0  # steps in the files as last written (those taken from a resumed file included)
+
+    def add(self, step, history, pressure=None, gap=None):
+        """Record a finished step: its summary, residual history and (whole) fields, pressure and length units."""
+        index = len(self.steps)
+        self.steps.append(step)
+        self.histories[index] = history
+        if pressure is not None:  # the last fields are kept for -plot even with -output_fields none
+            self.last_fields = {"pressure": pressure, "gap": gap}
+            if self.keep == "all":
+                self.step_fields[index] = self.last_fields
+
+    def as_summary(self):
+        return dict(self.summary, steps=self.steps)
+
+    def write(self, h5_path, json_path=None, comm=None, with_fields=True):
+        """Write the files of the steps so far, each atomically.
+
+        On rank 0 alone, or, for a record of distributed fields (``first_row``), on every rank of
+        ``comm`` (the JSON by rank 0). ``with_fields=False`` leaves the pressure and gap fields out
+        (rank 0 alone after an interruption, when the other ranks may not take part).
+        """
+        start = time.perf_counter()
+        distributed = self.first_row is not None and with_fields
+        rank0 = comm is None or comm.Get_rank() == 0
+        if h5_path:
+            kept = self.last_fields if self.keep != "none" and with_fields else {}
+            step_fields = self.step_fields if with_fields else {}
+            load_path.write(h5_path, self.as_summary(), dict(heights=self.heights, **kept), self.histories,
+                            step_fields, self.stresses, comm=comm if distributed else None,
+                            first_row=self.first_row if distributed else None)
+        if json_path and rank0:
+            io.write_json(json_path, self.as_summary())
+        self.written = len(self.steps)
+        self.written_at = time.perf_counter()
+        self.write_seconds = self.written_at - start
+
+    def due(self):
+        """True when a checkpoint after this step keeps the writing under a fifth of the run time.
+
+        A rewrite costs more as the steps accumulate (``-output_fields all``);
+        between two writes at least four times the last write's duration passes.
+        """
+        return time.perf_counter() - self.written_at >= 4.0 * self.write_seconds
+
+    def resume_from(self, path, loads, load_option):
+        """Take from ``path`` the steps of ``loads`` it solved for the same problem.
+
+        ``loads`` is the list of ``(kind, value)`` of this run, given by ``-load_option``. The loads
+        saved in the file must be the first loads of this run (a longer list extends the path):
+        otherwise resuming would lose saved steps, and the run is refused, naming them. The
+        converged steps are taken up to the first that did not converge, which is solved again with
+        all after it. Returns the whole pressure field (pressure units) to start the next load from
+        (that of the last step taken, else the last one saved), or None.
+
+        Raises :class:`UserError` if the file records another problem (surface, grid, E*, solver,
+        control or tolerance) or other loads.
+        """
+        try:
+            stored = load_path.read(path)
+        except OSError as error:
+            raise UserError(f"-resume: cannot read {path} ({error})") from None
+        if stored is None:
+            raise UserError(f"-resume: {path} is not a roughpetsc solve output")
+        differ = load_path.differs_from(stored, self.summary, RESUME_KEYS)
+        if stored["heights"].shape != self.heights.shape or not np.array_equal(stored["heights"], self.heights):
+            differ.insert(0, "surface")
+        if differ:
+            raise UserError(f"-resume: {path} was made for another problem (different {', '.join(differ)}); "
+                            "give another -output, or the options that made it")
+        saved = [(step["summary"].get("load_option"), step["summary"].get("load_value")) for step in stored["steps"]]
+        check_continuation(path, saved, loads, load_option)
+        start = stored["last_fields"].get("pressure")
+        rows = slice(None) if self.first_row is None else slice(self.first_row, self.first_row + self.local_rows)
+        for step in stored["steps"]:
+            summary = step["summary"]
+            if not summary.get("converged"):
+                break
+            fields = [step["fields"][name][rows] if name in step["fields"] else None for name in ("pressure", "gap")]
+            self.add(summary, step["history"], *fields)
+            if "pressure" in step["fields"]:
+                start = step["fields"]["pressure"]
+        if self.keep != "none" and self.steps and len(self.steps) == len(stored["steps"]) \
+                and "pressure" in stored["last_fields"]:
+            # Every step taken: the last fields of the file are those of the last step taken.
+            self.last_fields = {name: array[rows] for name, array in stored["last_fields"].items()}
+        self.written = len(self.steps)
+        return start
+
+
+def describe_loads(loads):
+    """A few of the loads ``(kind, value)`` of a path, exactly as stored: ``pstar 0.1, 0.2, ..., 4 (95 loads)``."""
+    values = [repr(float(value)) for _, value in loads]
+    shown = values if len(values) <= 6 else values[:3] + ["..."] + values[-2:]
+    kinds = sorted({str(kind) for kind, _ in loads})
+    return f"{'/'.join(kinds)} {', '.join(shown)} ({len(values)} load{'s' if len(values) != 1 else ''})"
+
+
+def check_continuation(path, saved, loads, load_option):
+    """Refuse a resumed run whose loads do not begin with the ``saved`` ones: it would drop saved steps.
+
+    ``saved`` and ``loads`` are lists of ``(kind, value)``; ``load_option`` names the option of ``loads``.
+    """
+    loads = [(kind, float(value)) for kind, value in loads]
+    saved = [(kind, float(value)) for kind, value in saved]
+    if loads[:len(saved)] == saved:
+        return
+    if len(loads) < len(saved) and saved[:len(loads)] == loads:
+        why = f"this run's -{load_option} stops after {len(loads)} of them"
+    else:
+        at = next(i for i, (ours, theirs) in enumerate(zip(loads, saved)) if ours != theirs)
+        why = (f"this run's -{load_option} differs at step {at + 1}: {loads[at][0]} {loads[at][1]!r} here, "
+               f"{saved[at][0]} {saved[at][1]!r} in the file")
+    raise UserError(f"-resume: {path} holds {len(saved)} saved step(s), {describe_loads(saved)}, and {why}; "
+                    "resuming would lose saved steps. Give loads that begin with the saved ones (a longer list "
+                    "extends the path), or another -output")

@@ -1,0 +1,152 @@
+"""Generated periodic surfaces on a uniform grid: self-affine fractals (7.1)-(7.5), bisinusoid (3.52), wave, sphere.
+
+Array layout: a surface is a real array of shape ``(n0, n1)``; axis 0 ("rows",
+``y``) is the one distributed over MPI ranks, axis 1 (``x``) is contiguous.
+Heights are returned with zero mean (docs/conventions.md). Wavenumbers are in
+cycles per length, as in the Fourier pair (2.1)/(2.2) of the dissertation.
+
+Bad values raise :class:`~roughpetsc.errors.ParameterError` naming the Python
+parameter; the command line names the option (``roughpetsc.cli``).
+"""
+
+
+import numpy as np
+
+from ..errors import ParameterError
+
+
+def fractal_amplitude(k_l, k_s, hurst, m2):
+    """PSD amplitude C of (2.18) with k_r = k_l from a prescribed m2^h, eq. (7.1).
+
+    ``C = 4 (1 - H) m2 / ((2 pi)^3 (k_s^(2-2H) - k_l^(2-2H)))`` [length^(4-2H)] with ``k_l``,
+    ``k_s`` in cycles/length and ``m2`` dimensionless. The one source of C: the models call it
+    ``psd_amplitude`` (:mod:`roughpetsc.models.persson`).
+    """
+    return 4.0 * (1.0 - hurst) * m2 / ((2.0 * np.pi) ** 3 * (k_s ** (2 - 2 * hurst) - k_l ** (2 - 2 * hurst)))
+
+
+def fractal_psd(k, k_l, k_s, hurst, amplitude):
+    """Isotropic self-affine PSD (2.18) with k_r = k_l: C k^-2(1+H) on [k_l, k_s], else 0."""
+    k = np.asarray(k, dtype=float)
+    inside = (k >= k_l) & (k <= k_s)
+    psd = np.zeros_like(k)
+    psd[inside] = amplitude * k[inside] ** (-2.0 * (1.0 + hurst))
+    return psd
+
+
+def check_fractal_parameters(grid, k_l, k_s, hurst, m2):
+    """Raise :class:`ParameterError` for a PSD (2.18) that the grid cannot hold or that does not exist."""
+    nyquist = min(grid.n0 / grid.l0, grid.n1 / grid.l1) / 2.0
+    if not 0.0 < hurst < 1.0:
+        raise ParameterError("hurst", f"the Hurst exponent must lie in (0, 1), got {hurst}")
+    if not m2 > 0.0:
+        raise ParameterError("m2", f"the mean square slope m2 must be positive, got {m2}")
+    if not 0.0 < k_l < k_s:
+        raise ParameterError("k_l", f"need 0 < k_l < k_s for the cut-off wavenumbers, got k_l={k_l}, k_s={k_s}")
+    if k_s > nyquist:
+        raise ParameterError("k_s", f"the cut-off k_s={k_s} exceeds the Nyquist wavenumber {nyquist} of the grid")
+    if k_l < 1.0 / max(grid.l0, grid.l1):
+        raise ParameterError("k_l", f"the cut-off k_l={k_l} is below the fundamental wavenumber of the cell")
+
+
+GENERATORS = ("filter", "xu")
+
+
+def fractal(grid, k_l, k_s, hurst, m2, seed, generator="filter"):
+    """Gaussian isotropic self-affine surface of section 7.1, with the PSD (2.18) (k_r = k_l, C from (7.1)).
+
+    White Gaussian noise (unit variance, one sample per node, drawn from
+    ``numpy.random.default_rng(seed)``) is transformed and shaped in Fourier space:
+
+    * ``generator="filter"``: multiplied by ``sqrt(S(k) n0 n1 / A0)``, so that the *expected* discrete
+      spectrum is the PSD; the amplitude of each mode is random, as the noise's.
+    * ``generator="xu"``: (7.2)-(7.5) of the dissertation (Xu and Jackson's algorithm): divided by the
+      noise's own spectrum (its modulus, ``S[h0]`` of (7.4)) and multiplied by the same factor, so that
+      every realisation carries the prescribed amplitude ``sqrt(S(k))`` exactly and only the phase (that
+      of the noise, uniform and Hermitian-symmetric; the random phase theta of (7.5) is absorbed in it)
+      is random. Spectral moments are then the same for every seed.
+
+    The Hermitian symmetry (7.5) holds because the noise is real. The result is the same array on every
+    MPI rank: each rank computes the whole surface and keeps its rows.
+
+    Returns
+    -------
+    ndarray, shape (n0, n1): heights with zero mean, length units.
+    """
+    check_fractal_parameters(grid, k_l, k_s, hurst, m2)
+    if generator not in GENERATORS:
+        raise ParameterError("generator", f"the surface generator is one of {', '.join(GENERATORS)}, "
+                                          f"got '{generator}'")
+    amplitude = fractal_amplitude(k_l, k_s, hurst, m2)
+    noise = np.random.default_rng(seed).standard_normal(grid.shape)
+    spectrum = np.fft.rfft2(noise)
+    del noise
+    if generator == "xu":
+        # The noise's expected |F|^2 is n0 n1: dividing by |F| and multiplying by sqrt(n0 n1) keeps the
+        # scale of the filter, so both generators have the same expected moments.
+        modulus = np.abs(spectrum)
+        spectrum *= np.where(modulus > 0, np.sqrt(grid.size) / np.where(modulus > 0, modulus, 1.0), 0.0)
+    k0, k1 = grid.rfft_wavenumbers()
+    k = np.hypot(k0, k1)
+    spectrum *= np.sqrt(fractal_psd(k, k_l, k_s, hurst, amplitude) * grid.size / grid.area)
+    spectrum[0, 0] = 0.0
+    return np.fft.irfft2(spectrum, s=grid.shape)
+
+
+def check_waviness(amplitude, *wavelengths):
+    """Raise :class:`ParameterError` unless the amplitude and the wavelengths (length units) are positive."""
+    if not amplitude > 0:
+        raise ParameterError("amplitude", f"the amplitude must be positive, got {amplitude}")
+    if not all(wavelength > 0 for wavelength in wavelengths):
+        raise ParameterError("wavelength", f"the wavelength must be positive, got {', '.join(map(str, wavelengths))}")
+
+
+def check_divides(cell, wavelength):
+    """Raise :class:`ParameterError` unless ``wavelength`` divides the periodic cell's side ``cell`` (length units).
+
+    A wave that does not fit a whole number of times into the cell is cut at the cell's edge, and the
+    periodic cell repeats that cut: another surface than the one asked for.
+    """
+    count = cell / wavelength
+    if not (round(count) >= 1 and abs(count - round(count)) <= 1e-9 * count):
+        raise ParameterError("wavelength", f"the wavelength {wavelength:g} does not divide the cell side {cell:g} "
+                                           f"({count:.6g} wavelengths); give the side divided by a whole number "
+                                           f"({cell:g}, {cell / 2:g}, {cell / 3:g}, ...)")
+
+
+def bisinusoid(grid, amplitude, wavelength0, wavelength1):
+    """Bisinusoidal waviness (3.52): Delta cos(2 pi y / lambda_y) cos(2 pi x / lambda_x), length units.
+
+    Each wavelength must divide its side of the cell (:func:`check_divides`).
+    """
+    check_waviness(amplitude, wavelength0, wavelength1)
+    check_divides(grid.l0, wavelength0)
+    check_divides(grid.l1, wavelength1)
+    y, x = grid.coordinates()
+    return amplitude * np.cos(2 * np.pi * y / wavelength0) * np.cos(2 * np.pi * x / wavelength1)
+
+
+def wave(grid, amplitude, wavelength):
+    """One-dimensional wave along axis 1 (Westergaard's problem), zero mean.
+
+    The profile ``2 h sin^2(pi x / lambda)`` less its mean ``h``, i.e.
+    ``-h cos(2 pi x / lambda)`` with ``h`` = ``amplitude``. Its complete-contact
+    pressure is ``p_star = pi E* h / lambda`` (Johnson, Contact Mechanics, 13.2). The wavelength must
+    divide the cell length (:func:`check_divides`).
+    """
+    check_waviness(amplitude, wavelength)
+    check_divides(grid.l1, wavelength)
+    _, x = grid.coordinates()
+    return np.broadcast_to(-amplitude * np.cos(2 * np.pi * x / wavelength), grid.shape).copy()
+
+
+def hertz_sphere(grid, radius):
+    """A paraboloid cap ``-r^2 / (2 R)`` centred in the cell, zero mean (a sphere in a large cell)."""
+    if not radius > 0:
+        raise ParameterError("radius", f"the radius of the sphere must be positive, got {radius}")
+    y, x = grid.coordinates()
+    r2 = (y - grid.l0 / 2) ** 2 + (x - grid.l1 / 2) ** 2
+    heights = -r2 / (2.0 * radius)
+    return heights - heights.mean()
+
+
