@@ -45,29 +45,19 @@ def read_law(values, given):
 
 
 def check(settings):
-    """Refuse, by option name, what adhesion cannot be combined with yet."""
+    """Refuse, by option name and before any work, what the command line cannot do with adhesion.
+
+    The solver (``-tao_type``), the boundary and the hardness are checked where the adhesive problem and its
+    solver are made (:class:`roughpetsc.contact.AdhesiveProblem`, the registry of solvers).
+    """
     if settings.control != "displacement":
         raise UserError(f"-{settings.load_option}: adhesive contact is solved under displacement control (it jumps "
                         "in and out of contact under load control); prescribe -gbar or -gbar_list")
-    if settings.tao_type not in (None, "almm"):
-        raise UserError(f"-tao_type {settings.tao_type}: the adhesive problem is solved by its projected CG on the "
-                        "gap (no -tao_type) or by TAO ALMM with the mean-gap equality (-tao_type almm)")
-    for refused, given in (("resume", settings.resume),
-                           ("hardness", settings.hardness), ("stress_depths", settings.stress_depths)):
+    for refused, given, why in (("resume", settings.resume, "a resumed path restarts from its saved pressure; the adhesive problem's unknown is the gap"),
+                                ("stress_depths", settings.stress_depths,
+                                 "the stresses are those of a contact pressure, not of adhesive tractions")):
         if given:
-            raise UserError(f"-{refused} cannot be combined with -adhesion yet (the adhesive problem is solved by "
-                            "its own projected CG on the gap)")
-    if settings.boundary != "periodic":
-        raise UserError("-boundary: adhesion is solved on the periodic cell only")
-
-
-def make_solver(settings, problem):
-    """The adhesive gap solver of the settings (the Solver facade's interface: solve, fields, name, destroy)."""
-    from ..contact.adhesive import AdhesiveContact
-    from ..solvers.options import max_seconds
-
-    return AdhesiveContact(problem, settings.adhesion, settings.kkt_rtol, max_seconds=max_seconds(None),
-                           solver=settings.tao_type or "gapcg")
+            raise UserError(f"-{refused} cannot be combined with -adhesion yet ({why})")
 
 
 def summary(law, statistics, E_star):

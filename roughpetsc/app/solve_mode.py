@@ -320,7 +320,6 @@ def build_problem(settings, reader, comm):
 
     from ..fft import plans as fftw
     from . import surface_options
-    from ..surface import files
     from ..contact.problem import ContactProblem
     from ..parallel import row_split
 
@@ -342,7 +341,6 @@ def solve_settings(settings, reader, comm, requests):
     from ..store import outputs as io
     from .. import store
     from . import surface_options
-    from ..surface import files
     from .options import check_unused
     from ..store.path_record import PathRecord
     from ..surface.moments import surface_moments
@@ -355,7 +353,7 @@ def solve_settings(settings, reader, comm, requests):
         problem.progress = progress_printer(settings, comm)
         statistics = surface_moments(grid, heights, settings.E_star)
         solver = make_solver(settings, problem)
-        unusable = getattr(solver, "unusable_options", list)()
+        unusable = solver.unusable_options()
         check_unused(final=False, unusable=unusable)  # misspellings fail now; those read after a solve, then
         summary = {"grid": [grid.n0, grid.n1], "length": [grid.l0, grid.l1], "E_star": settings.E_star,
                    "surface": statistics, "surface_parameters": dict(surface_options.parameters(reader), surface_L=grid.l1),
@@ -440,12 +438,13 @@ def report_interruption(settings, record):
 
 
 def make_solver(settings, problem):
-    """The Solver of ``-tao_type``, or the adhesive gap solver under ``-adhesion``."""
-    if settings.adhesion is not None:
-        return adhesive_options.make_solver(settings, problem)
+    """The Solver of ``-tao_type`` for the problem of the options: ``problem``, or its adhesive one (``-adhesion``)."""
+    from ..contact.adhesive import AdhesiveProblem
     from ..solvers import Solver
 
-    return Solver(problem, settings.control, settings.tao_type, settings.kkt_rtol)
+    with options_named():
+        physics = problem if settings.adhesion is None else AdhesiveProblem(problem, settings.adhesion)
+        return Solver(physics, settings.control, settings.tao_type, settings.kkt_rtol)
 
 
 def whole_last_fields(record, comm, distributed, settings):
@@ -516,35 +515,32 @@ def solve_path(settings, solver, record, comm, lines, requests, progress=None):
     dropped, and nothing more is written. ``progress``: the :class:`roughpetsc.kkt.Progress` to tell
     of each new step, or None.
     """
-    from petsc4py import PETSc
-
     from .interrupts import agreed
     from .options import check_unused
     from ..parallel import gather_rows
+    from ..solvers import drive
 
-    checked = False
     steps = settings.steps
-    for index, (kind, value) in enumerate(steps):
-        if index < len(record.steps):
-            continue
+    state = {"checked": False}
+
+    class Stopped(Exception):
+        """A stop was requested: the step that was running is dropped, nothing more is written."""
+
+    def starting(index, kind, value):
         if agreed(comm, requests.is_set()):
-            return True
+            raise Stopped
         if progress is not None:
             progress.start_step(index, len(steps), kind, value)
-        stage = PETSc.Log.Stage(f"RP step {index:03d} {kind}={value:g}")  # -log_view: one stage per load
-        stage.push()
-        try:
-            result = solver.solve(**{kind: value})
-        finally:
-            stage.pop()
+
+    def finished(index, kind, value, result):
         if agreed(comm, requests.is_set()) and not result.converged:
-            return True  # stopped by the request: solved again by a rerun
+            raise Stopped  # stopped by the request: solved again by a rerun
         solver_ran = not result.reason.startswith("COMPLETE_CONTACT")  # the exact answer runs no TAO
-        if not checked:
+        if not state["checked"]:
             # Once a TAO solve has run, every option must have been read; before, only those that are
             # not read during or after a solve (a path wholly beyond complete contact runs none).
             check_unused(final=solver_ran)
-            checked = solver_ran
+            state["checked"] = solver_ran
         if record.first_row is not None:
             fields = [field.copy() for field in solver.fields()]
         elif settings.gather_fields:
@@ -554,8 +550,14 @@ def solve_path(settings, solver, record, comm, lines, requests, progress=None):
         record.add(dict(result.summary(), load_option=kind, load_value=value), result.history, *fields)
         lines.add(step_line(result.summary()))
         # Not before every option is known to be used: a run refused for an unused option writes nothing.
-        if checked and index < len(steps) - 1 and checkpoint(settings, record, comm):
+        if state["checked"] and index < len(steps) - 1 and checkpoint(settings, record, comm):
             lines.flush()
+
+    try:
+        for _ in drive(solver, steps, on_step=finished, first=len(record.steps), on_start=starting):
+            pass
+    except Stopped:
+        return True
     return False
 
 

@@ -25,7 +25,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from . import surface_options
-from ..surface import files, summits as asperities, seeds, spectra
+from ..surface import summits as asperities, seeds, spectra
 from . import settings as mode_settings
 from ..errors import ParameterError, UserError
 from ..store.outputs import check_outputs, on_root

@@ -37,7 +37,7 @@ def probe_solver(s):
     from petsc4py import PETSc
 
     from ..contact.problem import ContactProblem
-    from ..solvers.facade import Solver
+    from ..solvers import Solver
     from ..surface.grid import Grid
     from ..surface.generators import wave
 
@@ -99,7 +99,7 @@ def solve_surface(reader, s, index, seed, group, run_id, between_steps):
 
     from ..app import surface_options
     from ..contact.problem import ContactProblem
-    from ..solvers.facade import Solver
+    from ..solvers import Solver, drive
 
     start = time.perf_counter()
     grid, heights = surface_options.from_options(reader, seed=seed)
@@ -108,11 +108,14 @@ def solve_surface(reader, s, index, seed, group, run_id, between_steps):
     try:
         solver = Solver(problem, "load", s.tao_type, s.rtol)
         rows, reasons = [], []
-        for pstar in s.loads:
-            result = solver.solve(pstar=float(pstar))
+
+        def keep(index, kind, value, result):
             rows.append(ensemble_file.step_row(result))
             reasons.append(str(result.reason))
             between_steps()
+
+        for _ in drive(solver, [("pstar", float(pstar)) for pstar in s.loads], on_step=keep):
+            pass
     finally:
         if solver is not None:
             solver.destroy()

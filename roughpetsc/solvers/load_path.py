@@ -14,18 +14,21 @@ from .registry import resolve
 LOAD_KINDS = ("pstar", "pbar", "gbar")
 
 
-def drive(solver, steps, on_step=None, first=0):
+def drive(solver, steps, on_step=None, first=0, on_start=None):
     """Solve ``steps`` (``(kind, value)`` pairs, kind one of pstar, pbar, gbar) in order with ``solver``.
 
     Each step runs in a PETSc log stage of its own (``-log_view``: ``RP step NNN kind=value``); ``on_step(index,
     kind, value, result)`` is called after each, before the next starts (it may record, checkpoint, print or
-    raise to stop). ``first`` skips the steps before it (a resumed path). Yields each result.
+    raise to stop), and ``on_start(index, kind, value)`` before each. ``first`` skips the steps before it (a
+    resumed path). Yields each result.
     """
     for index, (kind, value) in enumerate(steps):
         if index < first:
             continue
         if kind not in LOAD_KINDS:
             raise ParameterError("steps", f"a step is ('pstar' | 'pbar' | 'gbar', value), got '{kind}'")
+        if on_start is not None:
+            on_start(index, kind, value)
         stage = PETSc.Log.Stage(f"RP step {index:03d} {kind}={value:g}")
         stage.push()
         try:
