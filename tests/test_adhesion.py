@@ -1,4 +1,4 @@
-"""Adhesive contact in the periodic BEM (roughpetsc.adhesive, roughpetsc.solvers.gap_cg) against closed forms.
+"""Adhesive contact in the periodic BEM (roughpetsc.contact.AdhesiveProblem through the Solver facade) against closed forms.
 
 References: Derjaguin's approximation, exact for a paraboloid against a flat when the bodies are rigid
 (the force at closest gap D is 2 pi R (-phi(D)) for any law phi); the first-order conditions of
@@ -19,7 +19,8 @@ import pytest
 import h5py
 
 from conftest import MPI_ENV, ROOT, applications_at_time_limit, run_cli
-from roughpetsc.contact.adhesive import AdhesiveContact, approach_retraction, dissipated_energy
+from roughpetsc.contact import AdhesiveProblem, approach_retraction, dissipated_energy
+from roughpetsc.solvers import Solver, drive
 from roughpetsc.contact.problem import ContactProblem
 from roughpetsc.errors import ParameterError
 from roughpetsc.contact.laws import Dugdale, Exponential, make_law
@@ -36,15 +37,20 @@ def sphere(n, length=1.0):
 
 
 @contextlib.contextmanager
-def adhesive_problem(grid, heights, E_star, law, rtol):
-    """An :class:`AdhesiveContact` on a periodic problem, destroyed with it afterwards."""
+def adhesive_problem(grid, heights, E_star, law, rtol, **solver):
+    """The Solver of an :class:`AdhesiveProblem` on a periodic problem (mean gaps), destroyed with it afterwards."""
     problem = ContactProblem(grid, heights, E_star, fft_effort="FFTW_ESTIMATE")
-    adhesive = AdhesiveContact(problem, law, rtol=rtol)
+    adhesive = Solver(AdhesiveProblem(problem, law), "displacement", rtol=rtol, **solver)
     try:
         yield adhesive
     finally:
         adhesive.destroy()
         problem.destroy()
+
+
+def path(solver, gbars):
+    """The results of ``solver`` along the mean gaps ``gbars`` (the load-path driver)."""
+    return drive(solver, [("gbar", gbar) for gbar in gbars])
 
 
 def numpy_residuals(grid, heights, E_star, law, gbar, pbar, gap):
@@ -76,7 +82,7 @@ def test_rigid_sphere_meets_derjaguin():
     top = (heights - heights.mean()).max()
     with adhesive_problem(grid, heights, 1e7, Exponential(work, range_), 1e-10) as adhesive:
         for closest in (3 * range_, range_, 0.2 * range_):
-            result = adhesive.solve(closest + top)
+            result = adhesive.solve(gbar=closest + top)
             assert result.converged, result.reason
             force = result.pbar * grid.area
             derjaguin = -2 * math.pi * RADIUS * work * math.exp(-closest / range_)
@@ -92,7 +98,7 @@ def test_rough_adhesive_solution_meets_its_first_order_conditions(law):
     E_star = 1.0
     with adhesive_problem(grid, heights, E_star, law, 1e-10) as adhesive:
         for gbar in (1e-2, 7e-3, 5e-3):
-            result = adhesive.solve(gbar)
+            result = adhesive.solve(gbar=gbar)
             assert result.converged, result.reason
             pressure, gap = adhesive.fields()
             assert gap.min() >= 0 and gap.mean() == pytest.approx(gbar, rel=1e-12)
@@ -109,7 +115,7 @@ def test_approach_and_retraction_differ_and_dissipate():
     top = (heights - heights.mean()).max()
     gbars = top + approach_retraction(2e-3, -2e-3, 20)
     with adhesive_problem(grid, heights, 1.0, Dugdale(work, stress), 1e-9) as adhesive:
-        results = list(adhesive.path(gbars))
+        results = list(path(adhesive, gbars))
     assert all(r.converged for r in results), [r.reason for r in results if not r.converged]
     pbars = np.array([r.pbar for r in results])
     areas = np.array([r.A for r in results])
@@ -130,7 +136,7 @@ def test_bad_parameters_name_the_option():
     problem = ContactProblem(grid, heights, 1.0, fft_effort="FFTW_ESTIMATE", boundary="free")
     try:
         with pytest.raises(ParameterError, match="periodic"):
-            AdhesiveContact(problem, Exponential(1e-3, 1e-3))
+            AdhesiveProblem(problem, Exponential(1e-3, 1e-3))
     finally:
         problem.destroy()
 
@@ -141,18 +147,19 @@ import numpy as np
 import petsc4py
 petsc4py.init()
 from petsc4py import PETSc
-from roughpetsc.contact.adhesive import AdhesiveContact
+from roughpetsc.contact import AdhesiveProblem
 from roughpetsc.contact.problem import ContactProblem
+from roughpetsc.solvers import Solver
 from roughpetsc.contact.laws import Exponential
 from roughpetsc.surface.grid import Grid
 from roughpetsc.surface.generators import fractal
 grid = Grid(45, 32, 1.0, 1.0)
 heights = fractal(grid, 2, 10, 0.8, 1e-2, seed=5)
 problem = ContactProblem(grid, heights, 1.0, fft_effort="FFTW_ESTIMATE")
-adhesive = AdhesiveContact(problem, Exponential(5e-5, 1e-3), rtol=1e-11)
+adhesive = Solver(AdhesiveProblem(problem, Exponential(5e-5, 1e-3)), "displacement", rtol=1e-11)
 rows = []
 for gbar in (1e-2, 6e-3):
-    result = adhesive.solve(gbar)
+    result = adhesive.solve(gbar=gbar)
     assert result.converged, result.reason
     pressure, gap = adhesive.fields()
     rows.append((result.pbar, result.A, np.concatenate(problem.mpi.allgather(pressure))))
@@ -236,9 +243,9 @@ def test_tao_almm_meets_the_gap_cg():
     answers = []
     for solver in ("gapcg", "almm"):
         problem = ContactProblem(grid, heights, 1.0, fft_effort="FFTW_ESTIMATE")
-        adhesive = AdhesiveContact(problem, law, rtol=1e-9, solver=solver)
+        adhesive = Solver(AdhesiveProblem(problem, law), "displacement", solver, rtol=1e-9)
         try:
-            result = adhesive.solve(8e-3)
+            result = adhesive.solve(gbar=8e-3)
             assert result.converged, result.reason
             answers.append((result, adhesive.fields()[0]))
         finally:
@@ -260,7 +267,7 @@ def dugdale_wave_path(n, alpha, range_over_amplitude, steps=40):
     stress = work / (range_over_amplitude * amplitude)
     grid = Grid(4, n, 4.0 / n, 1.0)
     with adhesive_problem(grid, wave(grid, amplitude, 1.0), 1.0, Dugdale(work, stress), 1e-10) as adhesive:
-        results = list(adhesive.path(approach_retraction(2.2 * amplitude, 0.05 * amplitude, steps)))
+        results = list(path(adhesive, approach_retraction(2.2 * amplitude, 0.05 * amplitude, steps)))
     assert all(r.converged for r in results), [r.reason for r in results if not r.converged]
     return work, stress, results
 
@@ -308,7 +315,7 @@ def test_dugdale_sphere_meets_maugis(tabor, radius_0, median_tolerance, pulloff_
     top = (heights - heights.mean()).max()
     gbars = top + approach_retraction(2 * work / stress, -radius_0 ** 2, 30)
     with adhesive_problem(grid, heights, 1.0, Dugdale(work, stress), 1e-9) as adhesive:
-        results = list(adhesive.path(gbars))
+        results = list(path(adhesive, gbars))
     assert all(r.converged for r in results)
     scale = math.pi * work * RADIUS
     resolved = [r for r in results if math.sqrt(r.A_corrected / math.pi) > 4 / n]
@@ -349,7 +356,7 @@ def test_penny_shaped_adhesive_crack_meets_the_maugis_dugdale_crack():
     states = []
     with adhesive_problem(grid, heights_from_pressure_surface(grid, -surface), 1.0,
                           Dugdale(work, sigma * pressure), 1e-10) as adhesive:
-        for result in adhesive.path(np.concatenate([volumes, volumes[-2::-1]])):
+        for result in path(adhesive, np.concatenate([volumes, volumes[-2::-1]])):
             assert result.converged, result.reason
             gap = adhesive.fields()[1]
             b = math.sqrt((gap > 0).sum() / grid.size / math.pi) / length
@@ -393,9 +400,10 @@ def test_tao_almm_stops_within_a_line_search_of_its_time_limit(monkeypatch):
     grid = Grid(256, 256, 1.0, 1.0)
     problem = ContactProblem(grid, fractal(grid, 4, 64, 0.8, 1e-2, seed=4), 1.0, fft_effort="FFTW_ESTIMATE")
     at_limit = applications_at_time_limit(monkeypatch, problem)
-    adhesive = AdhesiveContact(problem, Exponential(5e-6, 1e-3), rtol=1e-13, max_seconds=0.3, solver="almm")
+    adhesive = Solver(AdhesiveProblem(problem, Exponential(5e-6, 1e-3)), "displacement", "almm", rtol=1e-13,
+                      options={"solve_max_time": 0.3})
     try:
-        result = adhesive.solve(8e-3)
+        result = adhesive.solve(gbar=8e-3)
         assert not result.converged and "time limit" in result.reason, result.reason
         assert at_limit and problem.operator.applications - at_limit[0] <= 40  # one line search's evaluations
     finally:

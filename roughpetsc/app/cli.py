@@ -10,6 +10,7 @@ flag it), 130 interrupted by Ctrl-C or SIGTERM (the finished steps are written;
 -resume continues).
 """
 
+from contextlib import contextmanager
 import os
 import signal
 import sys
@@ -29,11 +30,14 @@ MODES = {"solve": solve_mode, "stats": stats_mode, "models": models_mode, "ensem
 
 
 def all_options():
-    """``{name: default}`` of every option of roughpetsc (general, surface, each mode's)."""
+    """``{name: default}`` of every option of roughpetsc (general, surface, each mode's, the solvers').
+
+    The solvers' tables come with their modules: call it once PETSc is initialised.
+    """
     from .surface_options import SURFACE_OPTIONS
 
     table = GENERAL_OPTIONS + SURFACE_OPTIONS + [option for module in MODES.values() for option in module.OPTIONS]
-    return {name: default for name, default, _ in table}
+    return {name: default for name, default, _ in table + solve_mode.solver_options()}
 
 
 def all_option_names():
@@ -58,7 +62,7 @@ def presets_help():
 
 
 def print_help():
-    """Our options and the presets. Runs before PETSc is initialised, so it comes before PETSc's own -help."""
+    """Our options, the solvers' (each declared by its backend) and the presets."""
     from .surface_options import SURFACE_OPTIONS
 
     blocks = [format_help("roughpetsc options (python -m roughpetsc [options]; PETSc's options follow):",
@@ -66,9 +70,42 @@ def print_help():
     for mode, module in MODES.items():
         blocks.append(format_help(f"Mode {mode}:", module.OPTIONS))
         if module is solve_mode:
+            blocks.append(format_help("Solver options (each read by its solver, under its options prefix):",
+                                      solve_mode.solver_options()))
             blocks.append(solve_mode.SOLVER_HELP)
     blocks.append(presets_help())
     print("\n\n".join(blocks) + "\n", flush=True)
+
+
+@contextmanager
+def held_output(hold):
+    """Inside the block, what is written to file descriptor 1 (C's stdout too) is held, then written after it.
+
+    PETSc prints its own -help while it is initialised; ours comes first, and needs the solvers' option
+    tables, whose modules import PETSc: PETSc's lines are held until ours are printed.
+    """
+    if not hold:
+        yield
+        return
+    import ctypes
+    import tempfile
+
+    sys.stdout.flush()
+    libc = ctypes.CDLL(None)
+    with tempfile.TemporaryFile() as held:
+        saved = os.dup(1)
+        os.dup2(held.fileno(), 1)
+        try:
+            yield
+        finally:
+            libc.fflush(None)
+            os.dup2(saved, 1)
+            os.close(saved)
+            held.seek(0)
+            text = held.read()
+        print_help()
+        sys.stdout.buffer.write(text)
+        sys.stdout.flush()
 
 
 def resolve_presets(argv):
@@ -214,18 +251,18 @@ def run_command_line(argv=None):
 
     # Before PETSc starts: it reads the options files, and prints its own -help, as it is initialised.
     argv, preset_error = resolve_presets(sys.argv if argv is None else argv)
-    if any(item in ("-help", "--help") for item in argv[1:]):
+    show_help = any(item in ("-help", "--help") for item in argv[1:])
+    if show_help:
         # Help piped into `head` or `less` ends quietly when the reader stops, as any Unix tool does,
         # instead of in PETSc's SIGPIPE handler.
         signal.signal(signal.SIGPIPE, signal.SIG_DFL)
         argv = [*argv, "-no_signal_handler"]
-        if launcher_rank() == 0:
-            print_help()
     version = any(item in ("-version", "--version") for item in argv[1:])
     if version:  # PETSc's banner would come first and the run go on; our line names both versions instead
         argv = [item for item in argv if item not in ("-version", "--version")]
-    petsc4py.init(argv)
-    from petsc4py import PETSc
+    with held_output(show_help and launcher_rank() == 0):
+        petsc4py.init(argv)
+        from petsc4py import PETSc
 
     hide_unused_petsc_stages()
 

@@ -32,6 +32,19 @@ GENERAL_OPTIONS = [
     ("overwrite", False, "replace existing output files (without it an existing file is refused, never replaced)"),
 ]
 
+# Options several modes read, each declared once here and listed in the table of every mode that reads it.
+KKT_RTOL = ("kkt_rtol", 1e-8, "stop when the natural KKT residual ||min(p/pbar, g/sqrt(m0h))||_inf (and the load "
+                              "error) <= this")
+OUTPUT = ("output", "", "write an HDF5 file to PATH: in -mode solve heights, the fields of -output_fields, each "
+                        "step's results and residual history, units and descriptions, saved as the steps finish; in "
+                        "-mode ensemble the ensemble's file (default ensemble.h5), which a rerun resumes")
+FFT_THREADS = ("fft_threads", 1, "FFTW threads on one rank")
+FFT_EFFORT = ("fft_effort", "FFTW_MEASURE", "FFTW planner effort: FFTW_ESTIMATE | FFTW_MEASURE | FFTW_PATIENT "
+                                            "(measured plans are remembered, see -fft_wisdom)")
+QUIET = ("quiet", False, "print nothing but errors")
+ENSEMBLE_SEED = ("ensemble_seed", 1, "master seed of an ensemble; surface i gets SeedSequence(master).spawn(...)[i] "
+                                     "(31-bit, see the file)")
+
 # The option that sets each parameter the library names in a ParameterError (roughpetsc.errors), in every mode.
 PARAMETER_OPTIONS = {**{keyword: option for option, keyword in surface_options.FRACTAL_KEYWORDS.items()},
                      "n1": "surface_N", "n0": "surface_N0/-surface_N", "length": "surface_L",

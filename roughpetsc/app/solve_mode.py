@@ -14,14 +14,13 @@ import numpy as np
 
 from . import adhesion_options as adhesive_options
 from ..errors import UserError
-from .settings import GENERAL_OPTIONS, check_fft, check_modulus, check_rtol, options_named, read_table
+from .settings import FFT_EFFORT, FFT_THREADS, GENERAL_OPTIONS, KKT_RTOL, OUTPUT, QUIET, check_fft, check_modulus, check_rtol, options_named, read_table
 
 # Read by read_settings into SolveSettings (besides the loads -pstar, -pbar, -gbar, -pstar_list).
 SETTINGS_OPTIONS = [
-    ("kkt_rtol", 1e-8, "stop when the natural KKT residual ||min(p/pbar, g/sqrt(m0h))||_inf <= this"),
+    KKT_RTOL,
     ("json", "", "write a JSON summary (surface statistics, one entry per load step) to PATH"),
-    ("output", "", "write an HDF5 file to PATH: heights, the fields of -output_fields, each step's results and "
-                   "residual history, units and descriptions; a load path is saved as its steps finish"),
+    OUTPUT,
     ("output_fields", "last", "pressure and gap fields in -output: last (of the last step) | all (also every "
                               "step's, in steps/NNN/) | none"),
     ("resume", False, "continue the load path saved in -output: its converged steps for the same problem and "
@@ -32,12 +31,11 @@ SETTINGS_OPTIONS = [
                          "seconds): auto (only when a person watches: rank 0's output is a terminal, not a pipe or "
                          "a file, also under mpiexec) | on | off"),
     ("progress_interval", 3.0, "seconds between progress lines (> 0)"),
-    ("fft_threads", 1, "FFTW threads on one rank"),
-    ("fft_effort", "FFTW_MEASURE", "FFTW planner effort: FFTW_ESTIMATE | FFTW_MEASURE | FFTW_PATIENT "
-                                   "(measured plans are remembered, see -fft_wisdom)"),
+    FFT_THREADS,
+    FFT_EFFORT,
     ("fft_wisdom", "", "FFTW wisdom cache that makes measured plans, and so the iterates, repeat from run to run: "
                        "PATH, none, or empty for ~/.cache/roughpetsc/fftw-wisdom-<cpu>.json"),
-    ("quiet", False, "print nothing but errors"),
+    QUIET,
 ]
 
 # The physics beyond the periodic elastic half-space (read into SolveSettings).
@@ -71,18 +69,17 @@ LOAD_OPTIONS = [
 LOAD_KINDS = {"pstar": "pstar", "pbar": "pbar", "gbar": "gbar", "pstar_list": "pstar", "pbar_list": "pbar",
               "gbar_list": "gbar"}
 
-# Read by the solvers from the options database (roughpetsc.solvers).
-SOLVER_OPTIONS = [
-    ("solve_max_time", 0.0, "stop a solve after this many seconds, reported as DIVERGED_USER (0: no limit)"),
-    ("pk_pc", "fourier", "Polonsky-Keer preconditioner: fourier (inverse symbol pi E*|k| on the contact set) | none"),
-    ("pk_active_set", "bccg", "Polonsky-Keer active set: bccg (overlapping nodes join the free set, Polak-Ribiere "
-                              "without restarts) | pk (as published: nodes enter after the step, CG restarts)"),
-    ("pk_refresh", 50, "Polonsky-Keer: recompute K p from scratch at least every this many iterations"),
-    ("bound_pc", "", "TAO bnls/bntr/bntl/tron/gpcg: fourier (inverse symbol on the free set; default of the BNK "
-                     "types) | none (default of tron, gpcg) | options (-tao_*pc_type decides)"),
-]
+OPTIONS = LOAD_OPTIONS + PHYSICS_OPTIONS + SETTINGS_OPTIONS
 
-OPTIONS = LOAD_OPTIONS + PHYSICS_OPTIONS + SETTINGS_OPTIONS + SOLVER_OPTIONS
+
+def solver_options():
+    """The options of the solvers, declared next to their readers: the stopping rule's and each backend's.
+
+    Imports the solvers (and so PETSc): call it once PETSc is initialised.
+    """
+    from ..solvers import option_tables, stopping
+
+    return stopping.OPTIONS + [option for table in option_tables().values() for option in table]
 
 SOLVER_HELP = """Solvers (PETSc options):
   (no -tao_type)          Polonsky-Keer projected CG (TAO type python) with the bound-constrained active set
@@ -91,6 +88,8 @@ SOLVER_HELP = """Solvers (PETSc options):
   -tao_type <bound type>  blmvm bqnls bncg bqnkls bqnktr bnls bntr tron gpcg: displacement control directly,
                           load control by a safeguarded root find on the mean gap around that type
   -tao_type almm          load control by TAO ALMM (-tao_almm_subsolver_tao_type bqnls|blmvm|...)
+  with -adhesion          the projected CG on the gap (no -tao_type, or gapcg), or -tao_type almm with the
+                          mean-gap equality; displacement control (-gbar, -gbar_list)
   -tao_monitor, -tao_view, -log_view and every other TAO/KSP/PC option work as usual."""
 
 

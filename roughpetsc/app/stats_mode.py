@@ -29,7 +29,7 @@ from ..surface import summits as asperities, seeds, spectra
 from . import settings as mode_settings
 from ..errors import ParameterError, UserError
 from ..store.outputs import check_outputs, on_root
-from .settings import Option
+from .settings import ENSEMBLE_SEED, Option
 from .stats_output import FIELDS, closed_form_pdfs, report, result_document
 from ..surface.generators import fractal_amplitude
 from .surface_options import from_options
@@ -37,7 +37,7 @@ from .surface_options import from_options
 OPTIONS = [
     Option("stats_ensemble", 0, "number of realisations (seeds from -ensemble_seed, as in -mode ensemble); 0 = "
                                 "the one surface of the options"),
-    Option(*seeds.MASTER_SEED_OPTION),
+    Option(*ENSEMBLE_SEED),
     Option("stats_json", "", "write the statistics as JSON to PATH"),
     Option("stats_h5", "", "write the statistics and per-surface values to HDF5 PATH"),
     Option("stats_plot", "", "write PNG plots of the PDFs against the closed forms to PREFIX_h.png and "

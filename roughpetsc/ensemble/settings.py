@@ -14,17 +14,19 @@ from .statistics import MODEL_NAMES
 
 OPTIONS = [
     Option("ensemble_size", 50, "number of surfaces (indices 0..size-1; an existing file can be extended)"),
-    Option(*seeds.MASTER_SEED_OPTION),
+    Option(*mode_settings.ENSEMBLE_SEED),
     Option("ensemble_group_ranks", 1, "MPI ranks per group; each group solves whole surfaces (must divide the ranks)"),
     Option("ensemble_loads", "history", "p* steps: 'history' (7.11, 95 steps, D1 = 0.2/30) or a comma list"),
     Option("ensemble_models", "all", "statistical models stored beside the BEM: all | none | comma list of "
                                      "gw,nayak_bush,greenwood,bgt,bgt_asymptotic,ciavarella,persson"),
-    Option("output", "ensemble.h5", "the ensemble's HDF5 file; rerunning with an existing file resumes it"),
-    Option("kkt_rtol", 1e-8, "stop when the natural KKT residual <= this (and the load error)"),
-    Option("fft_threads", 1, "FFTW threads per rank"),
-    Option("fft_effort", "FFTW_MEASURE", "FFTW planner effort"),
-    Option("quiet", False, "print nothing but errors"),
+    Option(*mode_settings.OUTPUT),
+    Option(*mode_settings.KKT_RTOL),
+    Option(*mode_settings.FFT_THREADS),
+    Option(*mode_settings.FFT_EFFORT),
+    Option(*mode_settings.QUIET),
 ]
+# -output of an ensemble, when not given.
+DEFAULT_OUTPUT = "ensemble.h5"
 
 # Options that do not change the numbers of a surface (not part of the configuration a resume must match).
 NOT_NUMBERS = ("mode", "ensemble_size", "ensemble_group_ranks", "ensemble_models", "output", "quiet",
@@ -89,6 +91,8 @@ def read_settings(reader, ranks):
     mode_settings.check_rtol(given["kkt_rtol"])
     E_star = mode_settings.check_modulus(reader.getReal("E_star", 1.0))
     mode_settings.check_fft(given["fft_threads"], given["fft_effort"])
+    if not reader.hasName("output"):
+        given["output"] = DEFAULT_OUTPUT
     if not given["output"]:
         raise UserError("-output: give the path of the ensemble's HDF5 file")
     check_writable(given["output"], "output")

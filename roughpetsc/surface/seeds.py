@@ -17,8 +17,6 @@ import numpy as np
 SEED_BITS = 0x7FFFFFFF
 RULE = ("seed_i = SeedSequence(ensemble_seed, spawn_key=(i,)).generate_state(1, uint32)[0] & 0x7fffffff; "
         "surface = -surface_seed seed_i")
-MASTER_SEED_OPTION = ("ensemble_seed", 1, "master seed of an ensemble; surface i gets "
-                                          "SeedSequence(master).spawn(...)[i] (31-bit, see the file)")
 
 
 def surface_seed(master, index):
