@@ -103,7 +103,9 @@ def interrupt_after(run, marker, count):
         assert line, "the run ended before it could be interrupted: " + run.stderr.read()
         seen.append(line)
     run.send_signal(signal.SIGINT)
-    rest, stderr = run.communicate(timeout=300)
+    # Read on through run.stdout: communicate() would read the pipe past what readline() has buffered.
+    rest, stderr = run.stdout.read(), run.stderr.read()
+    run.wait(timeout=300)
     return "".join(seen) + rest, stderr
 
 

@@ -74,9 +74,10 @@ class StatsSettings:
     psd_band: tuple = None
 
     def record(self):
-        """``{name: value}`` of the settings: the document's ``settings`` (``e_star`` and ``fd_scheme`` are
-        what :func:`surface_statistics` reads)."""
-        return asdict(self)
+        """``{name: value}`` of the settings: the document's ``settings`` (``e_star``, ``fd_scheme``, ``psd`` and
+        ``psd_band`` are what :func:`surface_statistics` reads); ``psd_band`` as a list, empty for the default
+        of each surface (HDF5 attributes have no None)."""
+        return dict(asdict(self), psd_band=list(self.psd_band or ()))
 
 
 def read_settings(options):
