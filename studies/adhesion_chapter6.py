@@ -47,21 +47,22 @@ def group_heights(grid, number, seed):
 
 def bem_cycle(problem, law, pmax):
     """(p*, 1 - A*, g*, converged) along loading then unloading (rows), and the number of steps loaded."""
-    from roughpetsc.contact.adhesive import AdhesiveContact
+    from roughpetsc.contact import AdhesiveProblem
+    from roughpetsc.solvers import Solver
 
-    adhesive = AdhesiveContact(problem, law, rtol=1e-8)
+    adhesive = Solver(AdhesiveProblem(problem, law), "displacement", rtol=1e-8)
     rows = []
     try:
         gaps = []
         for gstar in np.geomspace(2.0, 1e-6, 60):
-            result = adhesive.solve(gstar * problem.sqrt_m0h)
+            result = adhesive.solve(gbar=gstar * problem.sqrt_m0h)
             gaps.append(gstar)
             rows.append((result.pstar, 1 - result.A, result.gstar, result.converged))
             if result.pstar >= pmax:
                 break
         loaded = len(rows)
         for gstar in gaps[-2::-1]:
-            result = adhesive.solve(gstar * problem.sqrt_m0h)
+            result = adhesive.solve(gbar=gstar * problem.sqrt_m0h)
             rows.append((result.pstar, 1 - result.A, result.gstar, result.converged))
     finally:
         adhesive.destroy()

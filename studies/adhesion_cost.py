@@ -4,7 +4,7 @@
 
 The surface is group #1 of Table 7.1 (``common.group1_problem``) with E* = 1. At g* = 1.5, 1.0 and
 0.5 it solves the non-adhesive problem with Polonsky-Keer under displacement control, then each
-adhesive case with the gap CG of :mod:`roughpetsc.adhesive`, both to the same natural residual. The
+adhesive case with the gap CG (:class:`roughpetsc.contact.AdhesiveProblem` through the Solver), both to the same natural residual. The
 cases are set in the surface's own scales: sqrt(m0^h) for the range and sqrt(m0^p) for the peak
 stress (weak: range 0.2, peak 0.1; strong: range 0.2, peak 1; short: range 0.01, peak 1, a range far
 below the height change between neighbouring nodes). Time and operator applications are given as
@@ -79,11 +79,12 @@ def reference_solve(problem, gbar, rtol):
 
 def adhesive_solve(problem, law, gbar, rtol):
     """The adhesive solve of ``law`` at the mean gap ``gbar`` from the rigid start (the gap CG)."""
-    from roughpetsc.contact.adhesive import AdhesiveContact
+    from roughpetsc.contact import AdhesiveProblem
+    from roughpetsc.solvers import Solver
 
-    adhesive = AdhesiveContact(problem, law, rtol=rtol)
+    adhesive = Solver(AdhesiveProblem(problem, law), "displacement", rtol=rtol)
     try:
-        return adhesive.solve(gbar)
+        return adhesive.solve(gbar=gbar)
     finally:
         adhesive.destroy()
 

@@ -68,7 +68,8 @@ def paraboloid_surface(grid, kappa_1, kappa_2):
 def run_case(n, sigma, ratio, steps):
     """Rows (p0, b, c, V, pbar, converged) along an opening and closing path of the crack."""
     from roughpetsc import ContactProblem, Grid
-    from roughpetsc.contact.adhesive import AdhesiveContact
+    from roughpetsc.contact import AdhesiveProblem
+    from roughpetsc.solvers import Solver
     from roughpetsc.contact.laws import Dugdale
 
     kappa_1 = ratio * KAPPA
@@ -87,11 +88,11 @@ def run_case(n, sigma, ratio, steps):
                               np.geomspace(v_turns, v_max, steps // 2)[1:]])
     gbars = np.concatenate([opening, opening[-2::-1]])
     problem = ContactProblem(grid, heights, E_STAR)
-    adhesive = AdhesiveContact(problem, Dugdale(work, stress), rtol=1e-10)
+    adhesive = Solver(AdhesiveProblem(problem, Dugdale(work, stress)), "displacement", rtol=1e-10)
     rows = []
     try:
         for gbar in gbars:
-            result = adhesive.solve(float(gbar))
+            result = adhesive.solve(gbar=float(gbar))
             _, gap = adhesive.fields()
             cell = grid.area / grid.size
             rows.append({"gbar": float(gbar), "p0": peak - result.pbar, "pbar": result.pbar,

@@ -39,7 +39,8 @@ def work_of(radius_0):
 
 def run_case(n, lam, steps, radius_0):
     from roughpetsc import ContactProblem, Grid
-    from roughpetsc.contact.adhesive import AdhesiveContact, approach_retraction
+    from roughpetsc.contact import AdhesiveProblem, approach_retraction
+    from roughpetsc.solvers import Solver
     from roughpetsc.contact.laws import Dugdale
 
     work = work_of(radius_0)
@@ -50,7 +51,7 @@ def run_case(n, lam, steps, radius_0):
     heights = -(xx ** 2 + yy ** 2) / (2 * RADIUS)
     top = float((heights - heights.mean()).max())
     problem = ContactProblem(grid, heights, E_STAR)
-    adhesive = AdhesiveContact(problem, Dugdale(work, stress), rtol=1e-9)
+    adhesive = Solver(AdhesiveProblem(problem, Dugdale(work, stress)), "displacement", rtol=1e-9)
     range_ = work / stress
     approach = radius_0 ** 2 / RADIUS  # of the order of the JKR approach at zero load
     rows = []
@@ -59,7 +60,7 @@ def run_case(n, lam, steps, radius_0):
         path = top + approach_retraction(2 * range_, -approach, steps)
         started = time.perf_counter()
         for step, gbar in enumerate(path, 1):
-            result = adhesive.solve(gbar)
+            result = adhesive.solve(gbar=gbar)
             rows.append({"gbar": gbar, "P": result.pbar * grid.area, "A": result.A,
                          "A_corrected": result.A_corrected, "natural": result.kkt.natural,
                          "converged": result.converged, "reason": result.reason})

@@ -72,22 +72,24 @@ def check(grid, heights, law, gbar, pressure, gap, result, rtol):
 
 
 def run_cell(problem, grid, heights, solver, case, rtol, max_time):
-    from roughpetsc.contact.adhesive import AdhesiveContact
+    from roughpetsc.contact import AdhesiveProblem
+    from roughpetsc.solvers import Solver
 
     kind, range_, peak = CASES[case]
     law = make_law(kind, problem, range_, peak)
-    adhesive = AdhesiveContact(problem, law, rtol=rtol, max_seconds=max_time, solver=solver)
+    adhesive = Solver(AdhesiveProblem(problem, law), "displacement", solver, rtol=rtol,
+                      options={"solve_max_time": max_time})
     start = time.perf_counter()
     try:
         if case == "near pull-off":
             results = []
             for gstar in np.linspace(0.5, 2.5, 13):
-                result = adhesive.solve(gstar * problem.sqrt_m0h)
+                result = adhesive.solve(gbar=gstar * problem.sqrt_m0h)
                 results.append((result.pbar, gstar, result, [a.copy() for a in adhesive.fields()]))
             _, gstar, result, (pressure, gap) = min(results, key=lambda item: item[0])
         else:
             gstar = 1.0
-            result = adhesive.solve(gstar * problem.sqrt_m0h)
+            result = adhesive.solve(gbar=gstar * problem.sqrt_m0h)
             pressure, gap = (a.copy() for a in adhesive.fields())
     finally:
         adhesive.destroy()

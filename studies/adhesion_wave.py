@@ -51,23 +51,23 @@ def parameters(alpha, range_over_amplitude):
 def run_case(n, work, stress, steps):
     """The approach-retraction path of one case on 4 x n nodes: a list of dicts (the reason of a stop only)."""
     from roughpetsc import ContactProblem, Grid
-    from roughpetsc.contact.adhesive import AdhesiveContact, approach_retraction
+    from roughpetsc.contact import AdhesiveProblem, approach_retraction
+    from roughpetsc.solvers import load_path
     from roughpetsc.contact.laws import Dugdale
     from roughpetsc.surface.generators import wave
 
     grid = Grid(4, n, 4.0 * WAVELENGTH / n, WAVELENGTH)
     problem = ContactProblem(grid, wave(grid, AMPLITUDE, WAVELENGTH), E_STAR)
-    adhesive = AdhesiveContact(problem, Dugdale(work, stress), rtol=1e-10)
+    gbars = approach_retraction(2.2 * AMPLITUDE, 0.05 * AMPLITUDE, steps)
     rows = []
     try:
-        for r in adhesive.path(approach_retraction(2.2 * AMPLITUDE, 0.05 * AMPLITUDE, steps)):
+        for r in load_path(AdhesiveProblem(problem, Dugdale(work, stress)), gbars=gbars, rtol=1e-10):
             rows.append({"gbar": float(r.gbar), "pbar": float(r.pbar), "A": float(r.A),
                          "converged": bool(r.converged)})
             if not r.converged:
                 rows[-1]["reason"] = r.reason
         return rows
     finally:
-        adhesive.destroy()
         problem.destroy()
 
 

@@ -4,17 +4,17 @@ Import after ``petsc4py.init`` (``init()`` does it). Every study script runs
 with the project's Python, where roughpetsc is installed (editable):
 ``.venv/bin/python studies/<script>.py``. Studies use public names only: the
 API of ``roughpetsc`` (its ``__all__``) first, a module's own public names
-(``roughpetsc.kkt.report``, ...) for what the API does not export.
+(``roughpetsc.contact.report``, ...) for what the API does not export. A preset's options reach its
+solver through ``Solver(..., options=preset)``, under a prefix of the solver's own.
 """
 
-import contextlib
 import os
 import sys
 import time
 
 from roughpetsc.app import presets as preset_files
 
-ROOT = preset_files.ROOT
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # the repository
 OUTPUT = os.path.join(ROOT, "studies", "output")
 
 
@@ -60,22 +60,12 @@ def load_controls(options):
     return options.get("tao_type", "") in ("", "almm")
 
 
-@contextlib.contextmanager
-def options_set(options):
-    """A preset's PETSc options in the database within the block, removed on exit (the rest untouched).
-
-    The solvers' scoped manager (``default_options(..., replace=True)``) inserts and removes them; a
-    preset option that nothing read by the end of the block stops the study (misspelled?).
-    """
-    from roughpetsc.app.options import unused_options
-    from roughpetsc.solvers.options import default_options
+def preset_solver(problem, options, rtol, control="load"):
+    """The Solver of a preset's options (its ``kkt_rtol`` aside: ``rtol`` decides), under a prefix of its own."""
+    from roughpetsc import Solver
 
     preset = {key: value for key, value in options.items() if key != "kkt_rtol"}
-    with default_options(preset, replace=True):
-        yield
-        unused = set(unused_options() or ()) & set(preset)  # None: cannot check here (a warning says so)
-    if unused:
-        raise SystemExit("options nothing read (misspelled?): " + ", ".join("-" + k for k in sorted(unused)))
+    return Solver(problem, control, rtol=rtol, options=preset)
 
 
 def solve(problem, options, rtol, control="load", monitor=None, **load):
@@ -83,18 +73,15 @@ def solve(problem, options, rtol, control="load", monitor=None, **load):
 
     ``monitor(tao)``, if given, is added to the TAO's monitors.
     """
-    from roughpetsc import Solver
-
     start = time.perf_counter()
-    with options_set(options):
-        solver = Solver(problem, control, options.get("tao_type") or None, rtol)
-        try:
-            if monitor is not None:
-                solver.tao.setMonitor(monitor)
-            result = solver.solve(**load)
-            field = solver.fields()[0].copy()
-        finally:
-            solver.destroy()
+    solver = preset_solver(problem, options, rtol, control)
+    try:
+        if monitor is not None:
+            solver.tao.setMonitor(monitor)
+        result = solver.solve(**load)
+        field = solver.fields()[0].copy()
+    finally:
+        solver.destroy()
     return result, field, time.perf_counter() - start
 
 

@@ -18,9 +18,10 @@ import numpy as np  # noqa: E402
 
 import roughpetsc.models as M  # noqa: E402
 from roughpetsc import ensemble  # noqa: E402
-from roughpetsc.app.presets import ROOT, fractal_group, fractal_groups  # noqa: E402
+from roughpetsc.app.presets import fractal_group, fractal_groups  # noqa: E402
 from roughpetsc.store.ensemble_file import stored_config  # noqa: E402
 
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # the repository
 OUT = os.environ.get("ROUGHPETSC_ENSEMBLE_DIR", os.path.join(ROOT, "studies", "output", "ensembles"))
 EXTRAS = os.path.join(OUT, "extras.h5")
 

@@ -12,14 +12,11 @@ promise.
 """
 
 import argparse
-import os
-import sys
 from collections import namedtuple
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(__file__))
-from ensemble_common import load_ensembles  # noqa: E402
+from ensemble_common import load_ensembles
 
 STAGES = (("ch7", (1, 2, 3, 4), 1024), ("ch8", tuple(range(18, 31)), 1024), ("ch8_2048", (27, 23, 25, 24, 26), 2048))
 

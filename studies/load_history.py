@@ -24,7 +24,7 @@ set, not by the nodes entering contact. Kept: the start's K p from the kept K p 
 and no fresh confirming K p inside PK (Solver certifies on a fresh gap and resumes PK if that fails):
 2 FFT pairs less per step, 0.478.
 
-Tried next (studies/load_path_recycling.py): a Galerkin start in the span of the last 2-10 solutions
+Tried next (studies/output/load_path_recycling_N*.md): a Galerkin start in the span of the last 2-10 solutions
 0.478-0.480 (N = 1024, 3 solutions: 0.516 against 0.525); with the previous solve's search directions added
 0.48; those directions as a recycled coarse space 0.54-0.78; a block coarse space 0.58 / 1.09 (iterations
 -17 % / -24 %, but its products cost 16 / 64 pairs a step, and it shortens the cold solve as much). At
@@ -42,10 +42,7 @@ import common
 
 
 def history_run(problem, options, loads):
-    from roughpetsc import Solver
-
-    with common.options_set(options):
-        solver = Solver(problem, "load", options.get("tao_type") or None, 1e-8)
+    solver = common.preset_solver(problem, options, 1e-8)
     try:
         start = time.perf_counter()
         results = [solver.solve(pstar=p) for p in loads]

@@ -35,13 +35,6 @@ def natural(problem, law, pressure, gap):
     return float(np.abs(np.minimum(gap / problem.sqrt_m0h, excess)).max())
 
 
-def energy(adhesive, gap):
-    """Pi of a gap field (length units), per unit area in the problem's scaled units (module roughpetsc.adhesive)."""
-    problem = adhesive.problem
-    g = problem.local(adhesive.gap)
-    g[...] = gap / problem.height_scale
-    adhesive.elastic_pressure(adhesive.gap, adhesive.elastic)
-    return adhesive.energy(g, problem.local(adhesive.elastic, readonly=True))
 
 
 def main():
@@ -52,7 +45,8 @@ def main():
     common.init()
     import peers
     from roughpetsc import ContactProblem, Grid
-    from roughpetsc.contact.adhesive import AdhesiveContact
+    from roughpetsc.contact import AdhesiveProblem
+    from roughpetsc.solvers import Solver
     from roughpetsc.contact.laws import Dugdale, Exponential
 
     rows = []
@@ -69,14 +63,15 @@ def main():
                 peak = strength * problem.sqrt_m0p
                 for name, law in (("exponential", Exponential(peak * range_, range_)),
                                   ("maugis", Dugdale(peak * range_, peak))):
-                    adhesive = AdhesiveContact(problem, law, rtol=1e-10)
+                    physics = AdhesiveProblem(problem, law)
+                    adhesive = Solver(physics, "displacement", rtol=1e-10)
                     try:
-                        result = adhesive.solve(gbar, start="uniform")
+                        result = adhesive.solve(gbar=gbar, start="uniform")
                         pressure, gap = (a.copy() for a in adhesive.fields())
                         case = {"N": n, "law": name, "peak / sqrt(m0p)": strength}
                         rows.append(dict(case, code="roughpetsc", tolerance=1e-10,
                                          natural=natural(problem, law, pressure, gap), A=result.A, pbar=result.pbar,
-                                         energy=energy(adhesive, gap), **{"max |dp| / sqrt(m0p)": 0.0},
+                                         energy=physics.energy_of(gap), **{"max |dp| / sqrt(m0p)": 0.0},
                                          **{"solve s": result.time_s}, converged=result.converged))
                         print(rows[-1], flush=True)
                         for tol in args.tolerances:
@@ -85,7 +80,7 @@ def main():
                             difference = float(np.abs(field - pressure).max() / problem.sqrt_m0p)
                             rows.append(dict(case, code="tamaas", tolerance=tol,
                                              natural=natural(problem, law, field, info["gap"]), A=info["A"],
-                                             pbar=float(field.mean()), energy=energy(adhesive, info["gap"]),
+                                             pbar=float(field.mean()), energy=physics.energy_of(info["gap"]),
                                              **{"max |dp| / sqrt(m0p)": difference}, **{"solve s": info["solve_s"]},
                                              converged=info["converged"]))
                             print(rows[-1], flush=True)

@@ -104,23 +104,13 @@ class Evaluator:
         self.work.destroy()
 
 
-def set_options(pairs, previous):
-    options = PETSc.Options()
-    for name, _ in previous:
-        if options.hasName(name):
-            options.delValue(name)
-    for name, value in pairs:
-        options.setValue(name, value)
-
-
-def run_ours(grid, heights, pairs, previous, pstar, rtol, repeats):
+def run_ours(grid, heights, pairs, pstar, rtol, repeats):
     """Solve with one option set ``repeats`` times from a cold start; the fastest run's numbers."""
-    set_options(pairs, previous)
     problem = ContactProblem(grid, heights, 1.0, PETSc.COMM_SELF)
     best, field = None, None
     try:
         for _ in range(repeats):
-            solver = Solver(problem, "load", None, rtol)
+            solver = Solver(problem, "load", rtol=rtol, options=dict(pairs))
             try:
                 cpu = time.process_time()
                 result = solver.solve(pstar=pstar)
@@ -239,10 +229,8 @@ def main():
             evaluate = Evaluator(problem, problem.scaled_pbar(pstar=args.pstar))
             log(f"N={n}: pbar={pbar:.6e} (p*={args.pstar}), sqrt(m0h)={problem.sqrt_m0h:.6e}")
             rows = []
-            previous = []
             for pairs in option_sets:
-                result, field = run_ours(grid, heights, pairs, previous, args.pstar, args.target, args.repeats)
-                previous = pairs
+                result, field = run_ours(grid, heights, pairs, args.pstar, args.target, args.repeats)
                 judged = evaluate(field)
                 rows.append({
                     "solver": label_of(pairs), "kind": "ours", "options": dict(pairs), "tolerance": args.target,

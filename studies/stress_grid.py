@@ -84,17 +84,14 @@ def independent(grid, heights, E_star, pressure, gap):
 
 
 def run_cell(problem, grid, heights, preset, options, pstar, rtol, max_time):
-    from roughpetsc import Solver
-
     row = {"pstar": pstar}
     start, cpu_start = time.perf_counter(), time.process_time()
-    with common.options_set(dict(options, solve_max_time=str(max_time))):
-        solver = Solver(problem, "load", options.get("tao_type") or None, rtol)
-        try:
-            result = solver.solve(pstar=pstar)
-            pressure, gap = (a.copy() for a in solver.fields())
-        finally:
-            solver.destroy()
+    solver = common.preset_solver(problem, dict(options, solve_max_time=max_time), rtol)
+    try:
+        result = solver.solve(pstar=pstar)
+        pressure, gap = (a.copy() for a in solver.fields())
+    finally:
+        solver.destroy()
     row.update(seconds=round(time.perf_counter() - start, 3), cpu_seconds=round(time.process_time() - cpu_start, 3),
                reason=result.reason, converged=bool(result.converged),
                reported_natural=result.kkt.natural, iterations=result.iterations, A=result.A)

@@ -25,7 +25,7 @@ class Recorder:
     """A toy backend: Polonsky-Keer from the registry, recording every call of the protocol."""
 
     def __init__(self, problem, control, name, settings):
-        self.inner = make_backend(problem, control, "pk", settings.rtol, settings.prefix)
+        self.inner = make_backend(problem, control, "pk", settings)
         self.name, self.tao = f"toy[{self.inner.name}]", self.inner.tao
         self.keeps_displacement = self.inner.keeps_displacement
         self.calls = []

@@ -1,4 +1,4 @@
-"""The preset files of the repository: ``solvers/*.opts`` (solver settings) and ``options/*.opts`` (surface groups).
+"""The preset files: ``solvers/*.opts`` (solver settings) and ``options/*.opts`` (surface groups), package data.
 
 A preset is a PETSc options file, one ``-name value`` a line, ``#`` comments. The command line
 passes them to PETSc (``-options_file``); Python code (the studies, the API) reads them with
@@ -9,8 +9,9 @@ passes them to PETSc (``-options_file``); Python code (the studies, the API) rea
 import glob
 import os
 
-# The folder holding the package: the presets solvers/*.opts and options/*.opts live there.
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# The presets solvers/*.opts and options/*.opts: package data, installed with roughpetsc (the repository's
+# top-level solvers/ and options/ link here).
+ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "presets")
 PRESET_FOLDERS = ("solvers", "options")
 
 

@@ -2,7 +2,7 @@
 
 from ..errors import ParameterError
 from ..surface.files import level, load, validate
-from ..surface.generators import bisinusoid, fractal, hertz_sphere, wave
+from ..surface.generators import DEFAULT_GENERATOR, bisinusoid, fractal, hertz_sphere, wave
 from ..surface.grid import square_grid
 
 
@@ -24,7 +24,7 @@ SURFACE_OPTIONS = [
     ("surface_H", 0.8, "fractal: Hurst exponent H in (0, 1)"),
     ("surface_m2", 2e-4, "fractal: prescribed m2^h (mean square slope along x), sets C by (7.1)"),
     ("surface_seed", 1, "fractal: seed of the white noise (same surface on any number of ranks)"),
-    ("surface_generator", "filter", "fractal: filter (white noise filtered by sqrt(PSD): random amplitudes) | xu "
+    ("surface_generator", DEFAULT_GENERATOR, "fractal: filter (white noise filtered by sqrt(PSD): random amplitudes) | xu "
                                     "((7.2)-(7.5): exact amplitude sqrt(PSD), random phase; the group presets')"),
     ("surface_amplitude", 0.01, "bisinusoid: Delta of (3.52); wave: h of 2h sin^2(pi x/lambda) [length]"),
     ("surface_wavelength", 0.0, "bisinusoid/wave: wavelength along x (0 = the cell length)"),

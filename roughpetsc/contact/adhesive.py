@@ -154,6 +154,18 @@ class AdhesiveProblem:
         sums = allsum(self.mpi, [0.5 * (np.dot(g.ravel(), e) + np.dot(h, e)), self.scaled_law.energy(g).sum()])
         return float(sums.sum() / self.n)
 
+    def energy_of(self, gap):
+        """Pi (scaled, per unit area) of a whole gap field ``gap`` in length units (one operator application)."""
+        gap_vec, elastic_vec = self.vec(), self.vec()
+        try:
+            g = self.local(gap_vec)
+            g[...] = np.asarray(gap)[self.local_rows] / self.height_scale
+            self.elastic_pressure(gap_vec, elastic_vec)
+            return self.energy(g, self.local(elastic_vec, readonly=True))
+        finally:
+            gap_vec.destroy()
+            elastic_vec.destroy()
+
     # --- results ----------------------------------------------------------------
     def certify(self, unknown, work, outcome, target, control, rtol, solver, started, applications):
         """The :class:`Result` of the gap ``unknown`` at the scaled mean gap ``target``, certified on a fresh S g.

@@ -141,13 +141,13 @@ def _records_from(surfaces, steps, reasons):
 def stored_config(config, options):
     """The configuration JSON of a file, as a dict; a file written before the fractal surface's generator was part
     of it gets the generator its options JSON records (``-surface_generator``, else the option's default)."""
-    from ..app.surface_options import option_default
+    from ..surface.generators import DEFAULT_GENERATOR
 
     config = json.loads(config)
     surface = config.get("surface", {})
     if surface.get("type") == "fractal" and "generator" not in surface:
         given = json.loads(options) if options else {}
-        surface["generator"] = given.get("surface_generator", option_default("surface_generator"))
+        surface["generator"] = given.get("surface_generator", DEFAULT_GENERATOR)
     return config
 
 

@@ -50,9 +50,10 @@ def check_fractal_parameters(grid, k_l, k_s, hurst, m2):
 
 
 GENERATORS = ("filter", "xu")
+DEFAULT_GENERATOR = "filter"  # the command line's embedded surface and files written before the choice existed
 
 
-def fractal(grid, k_l, k_s, hurst, m2, seed, generator="filter"):
+def fractal(grid, k_l, k_s, hurst, m2, seed, generator=DEFAULT_GENERATOR):
     """Gaussian isotropic self-affine surface of section 7.1, with the PSD (2.18) (k_r = k_l, C from (7.1)).
 
     White Gaussian noise (unit variance, one sample per node, drawn from
