@@ -1,188 +1,641 @@
-"""Displacement control by any bound-constrained TAO type: ``min 1/2 p'Kp + p'(d - h)``, ``p >= 0``.
+"""Every bound-constrained TAO type on the contact QP (3.41)-(3.44) of the dissertation, under both controls.
 
-The scaled QP of the contact problem (3.41)-(3.44) of the dissertation at a prescribed rigid
-separation d (the mean gap (3.38)). Registered under every name of :data:`BOUND_TYPES` for
-displacement control; under load control the same names mean the root find on d
-(:mod:`roughpetsc.solvers.root_find`) around this backend.
+Registered under every name of :data:`BOUND_TYPES` (``-tao_type blmvm``, ``Solver(problem, "load", "bqnls")``).
+Three things make them fast (studies/tao_speed.py, studies/output/tao_speed/):
+
+**Load control inside TAO, by an augmented Lagrangian on one scalar.** The load-controlled problem is
+``min 1/2 p'Kp - p'h`` over ``p >= 0`` with ``mean(p) = pbar``; the multiplier of the equality is the rigid
+separation d. Each inner solve minimises, by the TAO type,
+
+    L(p; lambda) = 1/2 p'Kp - p'h + lambda (sum p - n pbar) + c n / 2 (mean p - pbar)^2,  p >= 0,
+
+whose gradient is the gap ``K p - h + d`` at ``d = lambda + c (mean p - pbar)``: the solution is the
+displacement-controlled one at that d, with the rigid flat held by a spring of compliance c. The quadratic part
+is the same for every lambda, so the quasi-Newton memory stays valid from one inner solve to the next
+(``-bound_al_recycle``) and so does the pressure (warm start). lambda starts at the previous load's separation
+along a load path, else at Polonsky-Keer's separation of the start (zero mean gap on its contact set). Between
+inner solves lambda moves to the root of P(d) = pbar, P the mean pressure of the displacement-controlled
+solution: first by a Newton step with the contact stiffness k = -dP/dd = 1_C' K_CC^-1 1_C / n of the first inner
+solution (:func:`contact_stiffness`, a preconditioned CG on its contact set, 10 to 20 operator applications;
+``-bound_al_newton false``: the method of multipliers, lambda <- d), then by secants on (d, log P), kept inside
+the bracket the pairs give. The inner solves are inexact: one stops once its natural residual is below
+``-bound_al_eta`` times its load error (the stopping rule's ``inner_eta``); only the last is solved to the
+tolerance. The penalty c is in units of the compliance of the longest wavelength, L / pi
+(``-bound_al_penalty``, 1): the Hessian ``K + c/n 1 1'`` then has the spectrum of K with the rigid mode at the
+top of it (c = 10 or 100 cost 3 to 19 times more). ``-bound_load rootfind`` keeps the former method, a
+safeguarded root find on d around displacement-controlled solves (:mod:`~roughpetsc.solvers.root_find`).
+
+**The Fourier initial Hessian for the quasi-Newton types** (``-bound_h0 fourier|none``): BLMVM, BQNLS and the
+other BQNK types start each L-BFGS two-loop recursion from ``gamma B r``, B Polonsky-Keer's preconditioner on
+the free set (0 < p, or p at a bound with the gradient pointing inside) and ``gamma / diag(K)`` on the fixed
+nodes (:class:`FourierInitialHessian`); gamma corrects the scale from the exact minimiser along the line
+search's first trial after each direction (no operator application more). One FFT pair per quasi-Newton step,
+counted. With it an L-BFGS memory of one pair is the default, and BQNLS runs without its Bertsekas active-set
+estimate (which applies the initial Hessian a second time).
+
+**Fused callbacks.** The objective (exact increments, free of cancellation: TAO compares values that change by
+about residual^2) and the convergence test (natural residual, load error, the best iterate in one of two
+buffers) each make one pass over the vectors (:mod:`roughpetsc.contact.loops`), where numpy and Vec calls
+made about six and eleven.
+
+Working defaults for a shell Hessian are set before ``setFromOptions``, so that options override them: no TAO
+gradient tolerances (the natural-residual test decides), a high iteration limit (the BNK family stops at 50),
+subset type ``subvec`` for TRON and GPCG, CG as BNLS's KSP. The types that solve a Newton step with a KSP
+(BNLS, BNTR, BNTL, TRON, GPCG) get the Fourier preconditioner on the free set (``-bound_pc fourier``, the
+default of the BNK types), no PC (``none``, the default of TRON and GPCG), or what the options say
+(``options``). A TAO solve that stops for round-off is restarted from its best iterate while that lowers the
+residual.
 """
+
+import ctypes
+import math
 
 import numpy as np
 from petsc4py import PETSc
 
-from ..contact.certificate import report
+from ..contact import loops
 from ..errors import UserError
-from .objective import QuadraticObjective
-from .options import default_options, set_from_options
-from .preconditioner import FourierPreconditioner
+from ..parallel import allmax, allmin, allsum
+from .options import _petsc_library, default_options, set_from_options
+from .preconditioner import MEAN_MODE_WEIGHT, FourierPreconditioner
 from .protocol import Backend, Outcome
 from .registry import register
-from .stopping import DEFAULT_MAX_IT, ConvergenceTest, History, describe_stop, option_name
+from .stopping import DEFAULT_MAX_IT, ConvergenceTest, History, Verdict, describe_stop, option_name
 
 BOUND_TYPES = ("blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bqnktl", "bnls", "bntr", "bntl", "tron", "gpcg")
-# Types whose Newton step is a KSP solve on the free set: they take the Fourier preconditioner.
-# It is their default where it won (group #1, N = 512, p* = 0.5, displacement control: BNLS
-# 622 -> 495 operator applications); TRON and GPCG run faster without it (TRON 298 -> 315,
-# GPCG 434 -> 6520), so their default is no PC.
+# Types whose Newton step is a KSP solve on the free set: they take the Fourier preconditioner. It is their
+# default where it won (group #1, N = 512, p* = 0.5, displacement control: BNLS 622 -> 495 operator
+# applications); TRON and GPCG run faster without it (TRON 298 -> 315, GPCG 434 -> 6520).
 KSP_TYPES = ("bnls", "bntr", "bntl", "tron", "gpcg")
 FOURIER_DEFAULT_TYPES = ("bnls", "bntr", "bntl")
+QUASI_NEWTON_TYPES = ("blmvm", "bqnls", "bqnkls", "bqnktr", "bqnktl")
 BOUND_PRECONDITIONERS = ("fourier", "none", "options")
-OPTIONS = [
-    ("bound_pc", "", "TAO bnls/bntr/bntl/tron/gpcg: fourier (inverse symbol on the free set; default of the BNK "
-                     "types) | none (default of tron, gpcg) | options (-tao_*pc_type decides)"),
-]
-
-# Restarts of a TAO solve that stopped for round-off (BoundQP.solve): at most this many, and only
-# while each attempt lowers the best natural residual below this fraction of the previous one.
+INITIAL_HESSIANS = ("fourier", "none")
+LOAD_METHODS = ("al", "rootfind")
+# Bounds of the initial Hessian's scale gamma; it settled at 0.1-0.3 in the solves measured.
+GAMMA_BOUNDS = (1e-3, 1e3)
+# Restarts of a TAO solve that stopped for round-off: at most this many, and only while each attempt lowers the
+# best natural residual below this fraction of the previous one.
 MAX_RESTARTS = 8
 RESTART_GAIN = 0.9
 
+OPTIONS = [
+    ("bound_pc", "", "TAO bnls/bntr/bntl/tron/gpcg: fourier (inverse symbol on the free set; default of the BNK "
+                     "types) | none (default of tron, gpcg) | options (-tao_*pc_type decides)"),
+    ("bound_h0", "", "TAO blmvm/bqnls/bqnk*: initial Hessian of L-BFGS: fourier (Polonsky-Keer's preconditioner on "
+                     "the free set, their default) | none (PETSc's)"),
+    ("bound_load", "al", "TAO bound types under load control: al (augmented Lagrangian on mean(p) = pbar inside "
+                         "the solve) | rootfind (a safeguarded root find on the separation around displacement "
+                         "control)"),
+    ("bound_al_penalty", 1.0, "augmented Lagrangian: penalty c in units of the compliance of the longest wavelength"),
+    ("bound_al_eta", 0.1, "augmented Lagrangian: an inner solve stops once its natural residual is below this "
+                          "times its load error, in [0, 1)"),
+    ("bound_al_max_outer", 40, "augmented Lagrangian: at most this many inner solves"),
+    ("bound_al_recycle", True, "augmented Lagrangian: keep the quasi-Newton memory from one inner solve to the next"),
+    ("bound_al_newton", True, "augmented Lagrangian: first multiplier step by the contact stiffness (else lambda <- d)"),
+]
 
-def restartable(reason, test):
+
+def _check(error, what):
+    if error != 0:
+        raise RuntimeError(f"PETSc error {error} in {what}")
+
+
+def restartable(reason, watch):
     """True for the stops that round-off in the objective causes: a failed line search, stagnation."""
     return reason in (PETSc.TAO.Reason.DIVERGED_LS_FAILURE, PETSc.TAO.Reason.DIVERGED_TR_REDUCTION) \
-        or (reason == PETSc.TAO.Reason.DIVERGED_USER and test.stopped_by == "stagnation")
+        or (reason == PETSc.TAO.Reason.DIVERGED_USER and watch.stopped_by == "stagnation")
+
+
+class AugmentedQuadratic:
+    """The objective L(p; lambda) of the module docstring and its gradient, the gap at d = lambda + c (mean p - pbar).
+
+    ``penalty`` c = 0 and ``lam`` = d: the displacement-controlled QP ``1/2 p'Kp + p'(d - h)``. The value is
+    accumulated from exact increments, f(x) = f(r) + (x - r)'(g(x) + g(r)) / 2 (a quadratic in p for fixed
+    lambda), so that TAO's comparisons of values are free of cancellation; :meth:`configure` and
+    :meth:`restart` restart the values. The last evaluated point, its gap, its sum and its separation are cached.
+    """
+
+    def __init__(self, problem):
+        self.problem = problem
+        self.lam = 0.0
+        self.penalty = 0.0
+        self.pbar = None
+        self.value = 0.0
+        self.point, self.gap, self.scratch = problem.vec(), problem.vec(), problem.vec()
+        self.cached = False
+        self.state = None  # the PETSc object state of the evaluated Vec right after its evaluation
+        self.vec_handle = None
+        self.total = 0.0  # sum of p at the cached point
+        self.separation = 0.0  # d of the cached point's gap
+        self.initial_lam = False  # take lambda from the first evaluated point's contact set
+        # Armed by the initial Hessian after it made a direction: the next evaluation (the line search's first
+        # trial) records the exact minimiser along its step, in units of the step.
+        self.probe_armed = False
+        self.probe_ratio = None
+
+    def configure(self, lam, penalty=0.0, pbar=None):
+        """A new lambda (None: from the contact set of the first point evaluated), penalty and target."""
+        self.lam = 0.0 if lam is None else lam
+        self.initial_lam = lam is None
+        self.penalty = penalty
+        self.pbar = pbar
+        self.cached = False
+
+    def restart(self):
+        """Forget the cached point: the next evaluated point has f = 0 (a new TAO solve)."""
+        self.cached = False
+
+    def evaluate(self, x, out):
+        """``out = g(x)`` (one operator application); returns f(x)."""
+        problem = self.problem
+        x_local = x.getArray(readonly=True)
+        separation = self.lam
+        if self.penalty:
+            total, = allsum(problem.mpi, [loops.local_sum(x_local)])
+            separation += self.penalty * (total / problem.n - self.pbar)
+        problem.operator.displacement(x, out)
+        out_local = out.getArray()
+        if self.initial_lam:
+            # PK's separation of the start: zero mean gap on its contact set (no operator application more).
+            elastic = problem.local(self.scratch)
+            np.subtract(out_local.reshape(elastic.shape), problem.local(problem.heights, readonly=True), out=elastic)
+            self.lam = problem.contact_separation(x, elastic)
+            self.initial_lam = False
+            separation += self.lam
+        sums = loops.gradient_step(x_local, self.point.getArray(), self.gap.getArray(), out_local,
+                                   problem.heights.getArray(readonly=True), separation, out_local, self.cached)
+        before, after, total = allsum(problem.mpi, sums)
+        self.value = self.value + 0.5 * (before + after) if self.cached else 0.0
+        if self.probe_armed and self.cached:
+            # The first point after a new direction: how far along the step the quadratic's minimum lies.
+            self.probe_ratio = -before / (after - before) if after > before else None
+            self.probe_armed = False
+        self.cached = True
+        self.total, self.separation = total, separation
+        self.vec_handle, self.state = x.handle, x.stateGet()
+        return self.value
+
+    def cached_gap(self, x):
+        """``(gap, sum of p, separation)`` of the iterate ``x``, the gap as this rank's flat array.
+
+        From the cache when ``x`` is the Vec last evaluated and unchanged since, or equal to the cached point;
+        else evaluated (an operator application), which moves the base of the increments to ``x``.
+        """
+        fresh = self.cached and x.handle == self.vec_handle and x.stateGet() == self.state
+        fresh = bool(allmin(self.problem.mpi, [float(fresh)])[0])  # every rank must take the same branch
+        if not fresh and not (self.cached and x.equal(self.point)):
+            self.evaluate(x, self.scratch)
+        return self.gap.getArray(readonly=True), self.total, self.separation
+
+    def destroy(self):
+        for v in (self.point, self.gap, self.scratch):
+            v.destroy()
+
+
+class PenalizedCompliance:
+    """MATPYTHON context: the Hessian ``K + c/n 1 1' (+ a I)`` of the augmented Lagrangian (c = 0: K).
+
+    ``shift`` is the BNK family's Hessian perturbation, reset by the owner at each Hessian evaluation.
+    """
+
+    def __init__(self, problem):
+        self.problem = problem
+        self.penalty = 0.0
+        self.perturbation = 0.0
+
+    def mult(self, mat, x, y):
+        self.problem.operator.displacement(x, y)
+        shift = self.penalty * x.sum() / self.problem.n if self.penalty else 0.0
+        if shift:
+            y.shift(shift)
+        if self.perturbation:
+            y.axpy(self.perturbation, x)
+
+    def multTranspose(self, mat, x, y):
+        self.mult(mat, x, y)
+
+    def getDiagonal(self, mat, d):
+        d.set(self.problem.operator.diagonal + self.penalty / self.problem.n + self.perturbation)
+
+    def shift(self, mat, a):
+        self.perturbation += a
+
+
+class PenalizedFourier(FourierPreconditioner):
+    """Polonsky-Keer's preconditioner for the Hessian ``K + c/n 1 1'``: the mean mode on the free set C has the
+    compliance lambda_C + c |C| / n (lambda_C of K alone; with C every node, c)."""
+
+    penalty = 0.0
+
+    def mean_mode_compliance(self, contact, count):
+        compliance = super().mean_mode_compliance(contact, count)
+        if not self.penalty:
+            return compliance
+        return (compliance if np.isfinite(compliance) else 0.0) + self.penalty * count / self.problem.n
+
+
+class FourierInitialHessian(PenalizedCompliance):
+    """MATPYTHON context of the quasi-Newton types' initial Hessian: ``mult`` is the exact Hessian, ``solve``
+    Polonsky-Keer's Fourier approximation of its inverse on the free set (module docstring).
+
+    PETSc's L-BFGS applies ``MatSolve`` of its J0 in every two-loop recursion; the free set is that of the
+    objective's last evaluated point, the current iterate. The symbol on a free set overestimates the inverse of
+    K restricted to it (the Schur complement (K^-1)_FF >= (K_FF)^-1), and the line search then cut the first
+    trial step by 3 to 10 every iteration; so the approximation is scaled by gamma, multiplied at the line
+    search's first trial after each direction by where the quadratic's minimum lies along the step (exact, from
+    s'g before and after the step), within :data:`GAMMA_BOUNDS`. (Scaling by the step the line search accepted
+    let gamma sink to its bound from a uniform start: 1751 operator applications against 220.)
+    """
+
+    def __init__(self, problem, objective):
+        super().__init__(problem)
+        self.objective = objective
+        self.gamma = 1.0
+        self.mask = np.zeros(int(np.prod(problem.operator.local_shape)))  # 1.0 on the free set
+        self.residual = problem.vec()
+        self.fourier = PenalizedFourier(problem)
+        self.fixed_scale = 1.0 / problem.operator.diagonal
+        grid = problem.scaled_grid
+        self.longest_compliance = max(grid.l0, grid.l1) / np.pi
+
+    def _update_scale(self):
+        ratio = self.objective.probe_ratio
+        if ratio is not None and ratio > 0:
+            self.gamma = min(max(self.gamma * ratio, GAMMA_BOUNDS[0]), GAMMA_BOUNDS[1])
+        self.objective.probe_ratio = None
+        self.objective.probe_armed = True
+
+    @PETSc.Log.EventDecorator("RPBoundH0")  # -log_view: the initial Hessian's MatSolve, its FFT pair included
+    def solve(self, mat, b, x):
+        """``x = gamma B b`` on the free set, ``gamma b / diag(K)`` off it: four passes and one FFT pair."""
+        self._update_scale()
+        problem = self.problem
+        mpi = problem.mpi
+        upper = math.inf if problem.upper_bound is None else problem.upper_bound
+        source, residual, out = b.getArray(readonly=True), self.residual.getArray(), x.getArray()
+        count, total = allsum(mpi, loops.free_residual(
+            self.objective.point.getArray(readonly=True), self.objective.gap.getArray(readonly=True), upper,
+            source, self.mask, residual))
+        if count == 0:
+            loops.finish_initial_hessian(out, source, self.mask, 0.0, 0.0, self.fixed_scale, self.gamma)
+            return
+        mean = total / count
+        loops.shift_on(residual, self.mask, mean, residual)  # P r: zero mean on the free set
+        shape = problem.operator.local_shape
+        problem.operator.stiffness(residual.reshape(shape), out.reshape(shape))
+        out_mean = allsum(mpi, [loops.masked_sum(out, self.mask)])[0] / count
+        self.fourier.penalty = self.penalty
+        compliance = self.fourier.mean_mode_compliance(self.mask, count)
+        if not np.isfinite(compliance):
+            compliance = self.penalty if self.penalty else self.longest_compliance
+        mean_term = MEAN_MODE_WEIGHT * mean / compliance
+        loops.finish_initial_hessian(out, source, self.mask, out_mean, mean_term, self.fixed_scale, self.gamma)
+
+    def destroy(self, mat=None):
+        self.residual.destroy()
+        if self.fourier is not None:
+            self.fourier.destroy()
+            self.fourier = None
+
+
+def _set_lmvm_initial_hessian(tao, tao_type, mat):
+    """Make ``mat`` (with ``solve``) the initial Hessian J0 of the L-BFGS matrix of a BLMVM or BQNK ``tao``.
+
+    petsc4py 3.18 wraps TaoLMVMSetH0 (BLMVM) but not TaoGetLMVMMatrix (the BQNK types), which ctypes calls.
+    """
+    if tao_type == "blmvm":
+        tao.setLMVMH0(mat)
+        return
+    library = _petsc_library()
+    lmvm = ctypes.c_void_p()
+    _check(library.TaoGetLMVMMatrix(ctypes.c_void_p(tao.handle), ctypes.byref(lmvm)), "TaoGetLMVMMatrix")
+    _check(library.MatLMVMSetJ0(lmvm, ctypes.c_void_p(mat.handle)), "MatLMVMSetJ0")
+
+
+def _set_recycle(tao, flag):
+    """Keep the quasi-Newton memory from one TaoSolve to the next (TaoSetRecycleHistory; BLMVM's own flag)."""
+    library = _petsc_library()
+    handle = ctypes.c_void_p(tao.handle)
+    _check(library.TaoSetRecycleHistory(handle, ctypes.c_int(bool(flag))), "TaoSetRecycleHistory")
+    _check(library.TaoLMVMRecycle(handle, ctypes.c_int(bool(flag))), "TaoLMVMRecycle")
+
+
+def contact_stiffness(problem, pressure, preconditioner, rtol=1e-3, max_it=30):
+    """The contact stiffness k = -dP/dd = 1_C' K_CC^-1 1_C / n of the solution ``pressure``, by PCG on its contact set C.
+
+    The mean pressure of the displacement-controlled solution changes at this rate with the separation while
+    the contact set C (0 < p below the cap) stays. Preconditioned by Polonsky-Keer's Fourier preconditioner;
+    two operator applications per iteration; stops when k changes by less than ``rtol`` relatively. Returns k
+    (scaled), or None with C empty or every node.
+    """
+    operator = problem.operator
+    mpi = problem.mpi
+    p = problem.local(pressure, readonly=True).ravel()
+    contact = (p > 0.0).astype(np.float64)
+    if problem.upper_bound is not None:
+        contact[p >= problem.upper_bound] = 0.0
+    count, = allsum(mpi, [contact.sum()])
+    if count == 0 or count == problem.n:
+        return None
+    work = [problem.vec() for _ in range(3)]
+    try:
+        residual = contact.copy()
+        solution = np.zeros_like(residual)
+        z = problem.local(work[0]).ravel()
+        direction = problem.local(work[1]).ravel()
+        response = problem.local(work[2]).ravel()
+        preconditioner.apply(residual, z, contact, count, keep_load=False)
+        direction[...] = z
+        rz, = allsum(mpi, [np.dot(residual, z)])
+        stiffness = 0.0
+        for _ in range(max_it):
+            operator.displacement(work[1], work[2])
+            response *= contact
+            curvature, = allsum(mpi, [np.dot(direction, response)])
+            alpha = rz / curvature
+            solution += alpha * direction
+            residual -= alpha * response
+            previous, stiffness = stiffness, allsum(mpi, [solution.sum()])[0] / problem.n
+            if abs(stiffness - previous) <= rtol * stiffness:
+                break
+            preconditioner.apply(residual, z, contact, count, keep_load=False)
+            rz_new, = allsum(mpi, [np.dot(residual, z)])
+            direction *= rz_new / rz
+            direction += z
+            rz = rz_new
+        return stiffness
+    finally:
+        for v in work:
+            v.destroy()
+
+
+def next_multiplier(points, pbar, separation, stiffness=None):
+    """The next lambda: a secant step on the (d, log P) pairs, inside their bracket; the first a Newton step with
+    the contact ``stiffness`` (the multiplier update, lambda <- d, without one).
+
+    P(d) decreases with d, like exp(-d / l) at small loads (Bush, Gibson and Thomas), so log P is closer to
+    linear in d than P, and the steps are taken on it. A pair with P > pbar lies below the root, one with
+    P < pbar above it.
+    """
+    below = [d for d, p in points if p > pbar]
+    above = [d for d, p in points if p < pbar]
+    low = max(below) if below else -math.inf
+    high = min(above) if above else math.inf
+    d1, p1 = points[-1]
+    if len(points) < 2:
+        if not stiffness or not p1 > 0:
+            return separation  # the method of multipliers: lambda <- d
+        step = d1 + math.log(p1 / pbar) * p1 / stiffness  # d log P / dd = -k / P
+    else:
+        d0, p0 = points[-2]
+        if d1 == d0 or not (p0 > 0 and p1 > 0) or not (math.log(p1 / p0)) / (d1 - d0) < 0:
+            step = separation
+        else:
+            step = d1 + math.log(p1 / pbar) * (d1 - d0) / math.log(p0 / p1)  # root of the secant of log P
+    if not low < step < high:
+        step = 0.5 * (low + high) if math.isfinite(low) and math.isfinite(high) else separation
+    return step
 
 
 class BoundQP(Backend):
-    """Displacement control: the bound-constrained QP at a given separation, by TAO.
+    """A bound-constrained TAO type under load (augmented Lagrangian) or displacement control (module docstring).
 
-    Working defaults for a shell Hessian are set before ``setFromOptions`` so
-    that options override them: no gradient tolerances (the natural-residual
-    test decides), a high iteration limit (the BNK family stops at 50 by
-    default), subset type ``subvec`` for TRON and GPCG. The types that solve
-    a Newton step with a KSP (BNLS, BNTR, BNTL, TRON, GPCG) get the Fourier
-    preconditioner on the free set (``-bound_pc fourier``, the default of
-    the BNK types), no PC (``none``, the default of TRON and GPCG), or
-    whatever the options say (``options``).
-
-    Parameters
-    ----------
-    problem : ContactProblem
-    control : str
-        Unused (always displacement control); part of the factory signature of the registry.
-    tao_type : str
-        One of :data:`BOUND_TYPES`.
-    settings : roughpetsc.solvers.protocol.BackendSettings
+    Parameters are those of the registry's factories (``name``: the TAO type).
     """
 
     def __init__(self, problem, control, tao_type, settings):
         self.problem = problem
+        self.control = control
         self.rule = settings.rule
-        self.max_seconds = settings.max_seconds
-        self.objective = QuadraticObjective(problem)
-        self.best = problem.vec()  # the best iterate of a solve (lowest natural residual)
-        self.hessian = problem.operator.mat()
-        self.lower = problem.vec()
+        self.max_seconds = settings.rule.max_seconds
+        self.prefix = settings.prefix
+        options = PETSc.Options(settings.prefix)
+        self.penalty_factor = options.getReal("bound_al_penalty", 1.0)
+        self.eta = options.getReal("bound_al_eta", 0.1)
+        self.max_outer = options.getInt("bound_al_max_outer", 40)
+        self.recycle = options.getBool("bound_al_recycle", True)
+        self.newton = options.getBool("bound_al_newton", True)
+        h0 = options.getString("bound_h0", "") or ("fourier" if tao_type in QUASI_NEWTON_TYPES else "none")
+        preconditioner = options.getString("bound_pc", "") or \
+            ("fourier" if tao_type in FOURIER_DEFAULT_TYPES else "none")
+        self._check_options(h0, preconditioner)
+        self.objective = AugmentedQuadratic(problem)
+        self.stiffness_preconditioner = FourierPreconditioner(problem)
+        self.buffers = (problem.vec(), problem.vec())  # the best iterate is in buffers[best]
+        self.best = 0
+        self.lower, self.upper, self.gradient = problem.vec(), problem.vec(), problem.vec()
         self.lower.set(0.0)
-        self.upper = problem.vec()
         self.upper.set(PETSc.INFINITY if problem.upper_bound is None else problem.upper_bound)
-        self.gradient = problem.vec()
+        self.hessian_context = PenalizedCompliance(problem)
+        self.hessian = self._python_mat(self.hessian_context)
         self.fourier = self.preconditioning = None
+        self.initial_context = self.initial_hessian = None
+        self.last = None  # (natural, load error, mean p, separation) of the last iterate tested
         tao = self.tao = PETSc.TAO().create(problem.comm)
         tao.setOptionsPrefix(settings.prefix)
         tao.setType(tao_type)
-        self._preconditioner(tao_type, settings.prefix)
-        tao.setObjectiveGradient(self._objective_gradient, self.gradient)
-        tao.setHessian(self._hessian, self.hessian, self.preconditioning or self.hessian)
+        if tao_type in KSP_TYPES and preconditioner == "fourier":
+            # The inverse symbol on the free set, through the Hessian's preconditioning matrix and PC "mat".
+            self.fourier = FourierPreconditioner(problem)
+            self.preconditioning = self.fourier.mat()
+            tao.getKSP().getPC().setType("mat")
+        elif tao_type in KSP_TYPES and preconditioner == "none":
+            tao.getKSP().getPC().setType("none")
+        tao.setObjectiveGradient(lambda tao, x, g: self.objective.evaluate(x, g), self.gradient)
+        tao.setHessian(self._evaluate_hessian, self.hessian, self.preconditioning or self.hessian)
         tao.setVariableBounds((self.lower, self.upper))
         tao.setTolerances(gatol=0.0, grtol=0.0, gttol=0.0)
         tao.setMaximumIterations(DEFAULT_MAX_IT)
         tao.setMaximumFunctionEvaluations(10 * DEFAULT_MAX_IT)
-        with default_options(self._default_options(tao_type), settings.prefix):
+        with default_options(self._default_options(tao_type, h0), settings.prefix):
             set_from_options(tao, self.destroy)
-        self.name = tao.getType()
+        if h0 == "fourier" and tao_type in QUASI_NEWTON_TYPES:
+            self.initial_context = FourierInitialHessian(problem, self.objective)
+            self.initial_hessian = self._python_mat(self.initial_context)
+            _set_lmvm_initial_hessian(tao, tao_type, self.initial_hessian)
+        self.name = tao.getType() + ("(al)" if control == "load" else "")
 
     @staticmethod
-    def _default_options(tao_type):
+    def _default_options(tao_type, h0):
         defaults = {}
         if tao_type in ("tron", "gpcg"):
-            # The default mask subset and ILU fail on a shell Hessian.
-            defaults["tao_subset_type"] = "subvec"
+            defaults["tao_subset_type"] = "subvec"  # the default mask subset and ILU fail on a shell Hessian
         if tao_type == "bnls":  # its default KSP, STCG, took 100x the operator applications of CG here
             defaults["tao_bnk_ksp_type"] = "cg"
+        if h0 == "fourier" and tao_type in QUASI_NEWTON_TYPES:
+            # Fewest iterations and vector operations with the Fourier H0: memory 1, 2, 3, 5, 8 tried (group #1,
+            # N = 256 and 512, p* = 0.5).
+            defaults[f"tao_{tao_type}_mat_lmvm_hist_size"] = "1"
+        if tao_type == "bqnls" and h0 == "fourier":
+            defaults["tao_bnk_as_type"] = "none"
         return defaults
 
-    def _preconditioner(self, tao_type, prefix):
-        """The KSP's PC from ``-bound_pc`` (read here: a bad value is refused before any solve)."""
-        default = "fourier" if tao_type in FOURIER_DEFAULT_TYPES else "none"
-        preconditioner = PETSc.Options(prefix).getString("bound_pc", default)
+    def _check_options(self, h0, preconditioner):
+        prefix = self.prefix
+        if h0 not in INITIAL_HESSIANS:
+            raise UserError(f"{option_name('bound_h0', prefix)}: unknown initial Hessian '{h0}' "
+                            f"(one of {', '.join(INITIAL_HESSIANS)})")
         if preconditioner not in BOUND_PRECONDITIONERS:
-            self.destroy()
             raise UserError(f"{option_name('bound_pc', prefix)}: unknown preconditioner '{preconditioner}' "
                             f"(one of {', '.join(BOUND_PRECONDITIONERS)})")
-        if tao_type in KSP_TYPES and preconditioner == "fourier":
-            # The inverse symbol on the free set, through the Hessian's preconditioning matrix and PC "mat".
-            self.fourier = FourierPreconditioner(self.problem)
-            self.preconditioning = self.fourier.mat()
-            self.tao.getKSP().getPC().setType("mat")
-        elif tao_type in KSP_TYPES and preconditioner == "none":
-            self.tao.getKSP().getPC().setType("none")
+        if not self.penalty_factor > 0:
+            raise UserError(f"{option_name('bound_al_penalty', prefix)} must be positive, got {self.penalty_factor}")
+        if not 0 <= self.eta < 1:
+            raise UserError(f"{option_name('bound_al_eta', prefix)} must be in [0, 1), got {self.eta}")
+        if self.max_outer < 1:
+            raise UserError(f"{option_name('bound_al_max_outer', prefix)} must be at least 1, got {self.max_outer}")
 
-    def _objective_gradient(self, tao, x, gradient):
-        return self.objective.evaluate(x, gradient)
+    def _python_mat(self, context):
+        n_local = self.problem.vec().getLocalSize()
+        mat = PETSc.Mat().createPython(((n_local, self.problem.n), (n_local, self.problem.n)), context=context,
+                                       comm=self.problem.comm)
+        mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        mat.setUp()
+        return mat
 
-    def _hessian(self, tao, x, H, P):
-        H.getPythonContext().perturbation = 0.0  # a fresh Hessian: BNK's MatShift of the last one is undone
+    def _evaluate_hessian(self, tao, x, H, P):
+        self.hessian_context.perturbation = 0.0  # a fresh Hessian: BNK's MatShift of the last one is undone
 
-    @property
-    def separation(self):
-        return self.objective.separation
+    def _set_penalty(self, penalty):
+        self.hessian_context.penalty = penalty
+        if self.initial_context is not None:
+            self.initial_context.penalty = penalty
 
-    def solve(self, separation, pressure, guess=None, history=None):
-        """Solve at ``separation`` (scaled) from the start ``pressure`` (overwritten); ``guess`` is unused.
+    @PETSc.Log.EventDecorator("RPBoundTest")  # -log_view: the fused convergence test
+    def _natural_residual(self, tao):
+        """The convergence test's ``(natural, load error, fresh)`` in one pass, the iterate copied to the spare buffer."""
+        problem = self.problem
+        x = tao.getSolution()
+        gap, total, separation = self.objective.cached_gap(x)
+        mean_p = total / problem.n
+        pbar = self.objective.pbar
+        scale = pbar if pbar else (mean_p if mean_p > 0 else 1.0)
+        upper = math.inf if problem.upper_bound is None else problem.upper_bound
+        local = loops.natural_and_copy(x.getArray(readonly=True), gap, scale, upper,
+                                       self.buffers[1 - self.best].getArray())
+        natural, = allmax(problem.mpi, [local])
+        load_error = None if pbar is None else abs(mean_p - pbar) / pbar
+        self.last = (natural, load_error, mean_p, separation)
+        return natural, load_error, True
 
-        ``history`` (:class:`~roughpetsc.kkt.History`) collects the residuals of several solves (the
-        root find's); a fresh one by default.
+    def _keep_best(self, x):
+        self.best = 1 - self.best  # the spare buffer holds the iterate just tested
 
-        When TAO stops short of the tolerance for a reason that round-off can cause (a failed line
-        search, or no progress for many iterations), it is restarted from its best iterate with the
-        objective measured from there; this repeats while each attempt improves the best residual
-        by at least :data:`RESTART_GAIN`, at most :data:`MAX_RESTARTS` times. If the tolerance is
-        still not met, the best iterate is returned and the reason names the floor reached.
-        """
-        self.objective.restart(separation)
-        history = history or History(self.problem)
-        watch = self.rule.watch(history)
-        test = ConvergenceTest(watch, self._natural_residual, keep_best=lambda x: x.copy(self.best))
-        self.tao.setConvergenceTest(test)
-        # A start outside the bounds would be projected by TAO anyway; do it here.
-        local = self.problem.local(pressure)
-        np.maximum(local, 0.0, out=local)
-        if self.problem.upper_bound is not None:
-            np.minimum(local, self.problem.upper_bound, out=local)
+    def _run(self, pressure, test):
+        """TAO from ``pressure``, restarted from its best iterate while round-off stops it; ``(iterations, restarts)``."""
         iterations, restarts, floor = 0, 0, np.inf
         while True:
             self.objective.restart()
             self.tao.setSolution(pressure)
             self.tao.solve(pressure)
             iterations += self.tao.getIterationNumber()
-            test.iteration_offset = iterations
+            test.iteration_offset += self.tao.getIterationNumber()
             reason = self.tao.getConvergedReason()
-            if reason > 0 or not restartable(reason, test) or restarts == MAX_RESTARTS \
+            if reason > 0 or not restartable(reason, test.watch) or restarts == MAX_RESTARTS \
                     or not test.best_natural < RESTART_GAIN * floor:
-                break
+                return iterations, restarts
             floor = test.best_natural
             restarts += 1
-            watch.restart(iterations - 1)  # the next solve's first iteration, numbered iterations, counts one
-            self.best.copy(pressure)
-        if reason < 0 and np.isfinite(test.best_natural):
-            self.best.copy(pressure)
-        return Outcome(separation, iterations, describe_stop(reason, watch, restarts), history.as_array())
+            test.watch.restart(test.iteration_offset - 1)
+            self.buffers[self.best].copy(pressure)
 
-    def _natural_residual(self, tao):
-        """The natural residual of TAO's iterate on its gap (the objective's cache): the convergence test's input."""
-        x = tao.getSolution()
+    def _project(self, pressure):
+        local = self.problem.local(pressure)
+        np.maximum(local, 0.0, out=local)
+        if self.problem.upper_bound is not None:
+            np.minimum(local, self.problem.upper_bound, out=local)
+
+    @property
+    def separation(self):
+        return self.objective.separation
+
+    def solve(self, target, pressure, guess=None, history=None):
+        """Solve for ``target`` (scaled mean pressure or separation) from ``pressure`` (overwritten).
+
+        ``history`` (:class:`~roughpetsc.solvers.stopping.History`) collects the residuals of several solves
+        (a root find's); a fresh one by default.
+        """
+        self._project(pressure)
+        history = history or History(self.problem)
+        watch = self.rule.watch(history)
+        test = ConvergenceTest(watch, self._natural_residual, keep_best=self._keep_best)
+        self.tao.setConvergenceTest(test)
+        self.last = None
+        if self.control == "displacement":
+            return self._solve_displacement(target, pressure, test, history)
+        return self._solve_load(target, pressure, guess, test, history)
+
+    def _solve_displacement(self, separation, pressure, test, history):
+        self._set_penalty(0.0)
+        self.objective.configure(separation)
+        _set_recycle(self.tao, False)
+        iterations, restarts = self._run(pressure, test)
+        reason = self.tao.getConvergedReason()
+        if reason < 0 and np.isfinite(test.best_natural):
+            self.buffers[self.best].copy(pressure)
+        return Outcome(separation, iterations, describe_stop(reason, test.watch, restarts), history.as_array())
+
+    def _solve_load(self, pbar, pressure, guess, test, history):
+        """The augmented Lagrangian on mean(p) = pbar (module docstring); lambda starts at ``guess.separation``."""
         problem = self.problem
-        kkt = report(problem.mpi, x.getArray(readonly=True), self.objective.gap_of(x), problem.n, None,
-                     problem.upper_bound)
-        return kkt.natural, None, True
+        grid = problem.scaled_grid
+        penalty = self.penalty_factor * max(grid.l0, grid.l1) / np.pi
+        self._set_penalty(penalty)
+        lam = guess.separation if guess is not None else None
+        points = []  # (d, mean p) of each inner solution
+        iterations = restarts = 0
+        for outer in range(self.max_outer):
+            _set_recycle(self.tao, self.recycle and outer > 0)
+            self.objective.configure(lam, penalty, pbar)
+            test.watch.inner_eta = self.eta if outer < self.max_outer - 1 else 0.0
+            done, restarted = self._run(pressure, test)
+            iterations += done
+            restarts += restarted
+            if self.last is None:
+                gap, total, separation = self.objective.cached_gap(pressure)
+                mean_p = total / problem.n
+            else:
+                _, _, mean_p, separation = self.last
+            points.append((separation, mean_p))
+            if test.verdict is not Verdict.INNER_DONE:
+                break
+            stiffness = contact_stiffness(problem, pressure, self.stiffness_preconditioner) \
+                if len(points) == 1 and self.newton else None
+            lam = next_multiplier(points, pbar, separation, stiffness)
+        note = f"{len(points)} inner solve{'s' * (len(points) > 1)}"
+        reason = self.tao.getConvergedReason()
+        if test.verdict is Verdict.CONVERGED:
+            description = f"CONVERGED_USER ({note})"
+        elif test.verdict is Verdict.INNER_DONE:
+            description = f"DIVERGED_AL_MAX_OUTER ({note}, best of natural residual, load error " \
+                          f"{test.best_natural:.2g})"
+        else:
+            description = describe_stop(reason, test.watch, restarts, load_control=True, note=note)
+        if test.verdict is not Verdict.CONVERGED and np.isfinite(test.best_natural):
+            self.buffers[self.best].copy(pressure)
+        return Outcome(separation, iterations, description, history.as_array())
 
     def destroy(self):
         self.tao.destroy()
-        for obj in (self.objective, self.best, self.hessian, self.lower, self.upper, self.gradient,
-                    self.preconditioning, self.fourier):
+        # (PETSc destroys the contexts of the python Mats with them.)
+        for obj in (self.objective, *self.buffers, self.lower, self.upper, self.gradient, self.hessian,
+                    self.preconditioning, self.fourier, self.initial_hessian, self.stiffness_preconditioner):
             if obj is not None:
                 obj.destroy()
 
 
-register(BOUND_TYPES, BoundQP, controls=("displacement",), options=OPTIONS)
+def make_bound(problem, control, tao_type, settings):
+    """The bound type ``tao_type``: :class:`BoundQP`, or under load control with ``-bound_load rootfind`` the root find."""
+    method = PETSc.Options(settings.prefix).getString("bound_load", "al")
+    if method not in LOAD_METHODS:
+        raise UserError(f"{option_name('bound_load', settings.prefix)}: unknown method '{method}' "
+                        f"(one of {', '.join(LOAD_METHODS)})")
+    if control == "load" and method == "rootfind":
+        from .root_find import RootFind
+
+        return RootFind(problem, control, tao_type, settings)
+    return BoundQP(problem, control, tao_type, settings)
+
+
+register(BOUND_TYPES, make_bound, options=OPTIONS)

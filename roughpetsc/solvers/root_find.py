@@ -1,8 +1,9 @@
 """Load control by a safeguarded root find on the rigid separation around the displacement-controlled QP.
 
 The mean pressure of the solution of (3.41)-(3.44) of the dissertation at a separation d decreases
-monotonically in d; Brent's method finds the d whose mean pressure is the prescribed pbar. Registered
-for load control under every bound-constrained TAO type (:data:`~roughpetsc.solvers.bound_qp.BOUND_TYPES`).
+monotonically in d; Brent's method finds the d whose mean pressure is the prescribed pbar. The load control of
+the bound types with ``-bound_load rootfind`` (:func:`~roughpetsc.solvers.bound_qp.make_bound`), and of
+Polonsky-Keer under a hardness cap when its own load control fails (:class:`~roughpetsc.solvers.pk.CappedPKLoad`).
 """
 
 import math
@@ -11,9 +12,8 @@ import numpy as np
 
 from .stopping import History
 from ..contact.certificate import report
-from .bound_qp import BOUND_TYPES, BoundQP
+from .bound_qp import BoundQP
 from .protocol import Backend, Outcome
-from .registry import register
 
 
 class RootFind(Backend):
@@ -163,5 +163,3 @@ class RootFind(Backend):
         for v in (*self.bracket.values(), self.trial, self.gap):
             v.destroy()
 
-
-register(BOUND_TYPES, RootFind, controls=("load",))

@@ -127,6 +127,7 @@ class Verdict(enum.Enum):
     CONTINUE = "continue"
     CONFIRM = "confirm on a fresh gradient"
     CONVERGED = "converged"
+    INNER_DONE = "an inner solve done: its residual is below the share of the load error it may keep"
     MAX_ITERATIONS = "iteration limit"
     TIME_LIMIT = "time limit"
     STAGNATION = "stagnation"
@@ -135,6 +136,7 @@ class Verdict(enum.Enum):
     def tao_reason(self):
         """The TAO converged reason of a final verdict (None while iterating)."""
         return {Verdict.CONVERGED: PETSc.TAO.Reason.CONVERGED_USER,
+                Verdict.INNER_DONE: PETSc.TAO.Reason.CONVERGED_USER,
                 Verdict.MAX_ITERATIONS: PETSc.TAO.Reason.DIVERGED_MAXITS,
                 Verdict.TIME_LIMIT: PETSc.TAO.Reason.DIVERGED_USER,
                 Verdict.STAGNATION: PETSc.TAO.Reason.DIVERGED_USER}.get(self)
@@ -152,12 +154,17 @@ class Watch:
         Whether the last :meth:`assess` found a new best (the backend may then keep a copy).
     stopped_by : str or None
         ``"time limit"`` or ``"stagnation"`` when the watch ended the solve so.
+    inner_eta : float
+        An inner solve of an outer iteration on the load (an augmented Lagrangian) is done once its natural
+        residual is at most ``inner_eta`` times its load error (``INNER_DONE``); 0: every solve is solved to
+        the tolerance.
     """
 
     def __init__(self, rule, history, max_iterations=DEFAULT_MAX_IT):
         self.rule = rule
         self.history = history
         self.max_iterations = max_iterations
+        self.inner_eta = 0.0
         self.best_natural = np.inf
         self.best_iteration = 0
         self.improved = False
@@ -184,6 +191,8 @@ class Watch:
         merit = natural if load_error is None else max(natural, load_error)
         if merit < self.best_natural:
             self.best_natural, self.best_iteration, self.improved = merit, iteration, True
+        if self.inner_eta and load_error is not None and natural <= self.inner_eta * load_error:
+            return Verdict.INNER_DONE
         if iteration >= self.max_iterations:
             return Verdict.MAX_ITERATIONS
         if self.history.out_of_time(self.rule.max_seconds):
