@@ -1,0 +1,248 @@
+"""TAO's bound types against Polonsky-Keer under load and displacement control, before and after issue 40.
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python studies/tao_speed.py [--sizes 512 1024] [--pstars 0.05 0.5 2]
+        [--solvers blmvm bqnls gpcg tron] [--variants after before] [--max-time 600] [--profile 1024] [--report]
+
+Group #1 surface (seed 1), natural KKT residual 1e-8, FFTW_MEASURE plans remembered in the wisdom cache (so the
+iterates repeat from the second run of a size on). Per N and p*: Polonsky-Keer (the default solver) under load
+control gives the separation d; every solver then solves the load (``pstar``) and the QP at d, cold. Variants:
+``before``, the backends of roughpetsc/solvers/bound_qp.py and root_find.py (a root find on d around each
+type); ``after``, those of roughpetsc/solvers/bound_load.py (``fast_<type>``: the augmented Lagrangian on
+mean(p) = pbar, the Fourier initial Hessian of the quasi-Newton types, fused callbacks). ``--profile N``
+counts PETSc's vector operations and times our events per iteration for PK, BLMVM and BQNLS under
+displacement control at N, p* = 0.5 (the -log_view breakdown, read through petsc4py's log).
+
+FFT pairs (operator and preconditioner applications) are deterministic; wall times on the shared, loaded
+machine are not, so every ratio is from one run. Rows are kept in studies/output/tao_speed/tao_speed.json
+(rerunning skips measured rows); ``--report`` writes tao_speed.md and tao_speed.png from them.
+"""
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # before numpy/petsc4py load OpenBLAS (a threaded VecDot
+                                                    # took 1.4 ms at 65k doubles on the loaded machine)
+import argparse
+import time
+
+import common
+
+OUT = os.path.join(common.OUTPUT, "tao_speed")
+PROFILED_EVENTS = ("VecDot", "VecNorm", "VecScale", "VecCopy", "VecSet", "VecAXPY", "VecAYPX", "VecAXPBYCZ",
+                   "VecWAXPY", "VecPointwiseMult", "VecReduceArith", "VecScatterBegin", "SFSetGraph", "MatSolve",
+                   "TaoLSApply", "TaoObjGradEval", "RPFFTPair", "RPFourierPC", "RPKKTCheck", "RPBoundTest",
+                   "RPBoundH0")
+VECTOR_OPS = [e for e in PROFILED_EVENTS if e.startswith("Vec")]
+
+
+def backend_name(solver, variant):
+    if solver == "pk":
+        return None
+    return solver if variant == "before" else "fast_" + solver
+
+
+def problem_for(n):
+    from petsc4py import PETSc
+
+    from roughpetsc import fftw
+
+    with fftw.remembered_plans(PETSc.COMM_WORLD.tompi4py(), fftw.default_wisdom_path(), "FFTW_MEASURE"):
+        return common.group1_problem(n, effort="FFTW_MEASURE")
+
+
+def one_solve(problem, solver, variant, control, pstar, separation, max_time):
+    """One cold solve; a row of the table."""
+    import roughpetsc.solvers.bound_load  # noqa: F401  (registers the fast_<type> backends)
+
+    options = {"solve_max_time": str(max_time)}
+    if solver != "pk":
+        options["tao_type"] = backend_name(solver, variant)
+    load = {"pstar": pstar} if control == "load" else {"gbar": separation}
+    result, _, seconds = common.solve(problem, options, 1e-8, control=control, **load)
+    return {"iterations": result.iterations, "pairs": result.operator_applications,
+            "seconds": round(result.time_s, 3), "ms_per_pair": round(1e3 * result.time_s /
+                                                                      max(result.operator_applications, 1), 2),
+            "natural": result.kkt.natural, "load_error": result.kkt.load_error, "converged": bool(result.converged),
+            "reason": result.reason, "name": result.solver, "separation": result.separation}
+
+
+def warm_up(solvers, variants):
+    """One small solve of every backend first: the first solve of a process loads the compiled kernels."""
+    problem = common.group1_problem(128)
+    for variant in variants:
+        for solver in ["pk"] + list(solvers):
+            one_solve(problem, solver, variant, "load", 0.5, None, 60)
+    problem.destroy()
+
+
+def run_grid(args, path, rows):
+    done = {(r["variant"], r["N"], r["pstar"], r["solver"], r["control"]) for r in rows}
+    warm_up(args.solvers, args.variants)
+    for n in args.sizes:
+        problem = problem_for(n)
+        for pstar in args.pstars:
+            reference = [r for r in rows if (r["variant"], r["N"], r["pstar"], r["solver"], r["control"]) ==
+                         ("after", n, pstar, "pk", "load")]
+            plan = [("after", "pk", "load"), ("after", "pk", "displacement")]
+            plan += [(variant, solver, control) for variant in args.variants for solver in args.solvers
+                     for control in ("load", "displacement")]
+            for variant, solver, control in plan:
+                key = (variant, n, pstar, solver, control)
+                if key in done:
+                    continue
+                separation = reference[0]["separation"] if reference else None
+                row = {"variant": variant, "N": n, "pstar": pstar, "solver": solver, "control": control}
+                row.update(one_solve(problem, solver, variant, control, pstar, separation, args.max_time))
+                if key[3:] == ("pk", "load"):
+                    reference = [row]
+                rows.append(row)
+                done.add(key)
+                common.save_rows(path, rows)
+                print(f"N={n} p*={pstar} {variant:6s} {solver:6s} {control:12s} its {row['iterations']:6d} "
+                      f"pairs {row['pairs']:6d} {row['seconds']:8.2f} s {row['ms_per_pair']:7.1f} ms/pair "
+                      f"{row['reason']}", flush=True)
+        problem.destroy()
+
+
+def run_profile(n, path, max_time):
+    """Vector operations per iteration and seconds per event under displacement control at N, p* = 0.5."""
+    from petsc4py import PETSc
+
+    PETSc.Log.begin()
+    warm_up(["blmvm", "bqnls"], ["after", "before"])
+    problem = problem_for(n)
+    reference = one_solve(problem, "pk", "after", "load", 0.5, None, max_time)
+    rows = []
+    for variant, solver in (("after", "pk"), ("before", "blmvm"), ("before", "bqnls"), ("after", "blmvm"),
+                            ("after", "bqnls")):
+        stage = PETSc.Log.Stage(f"{variant}-{solver}")
+        stage.push()
+        row = one_solve(problem, solver, variant, "displacement", 0.5, reference["separation"], max_time)
+        stage.pop()
+        counts = {e: PETSc.Log.Event(e).getPerfInfo(stage.id) for e in PROFILED_EVENTS}
+        row.update({"variant": variant, "solver": solver, "N": n,
+                    "events": {e: [info["count"], round(info["time"], 4)] for e, info in counts.items()}})
+        rows.append(row)
+        print(f"{variant} {solver}: {row['iterations']} its, {row['pairs']} pairs, {row['seconds']} s, "
+              f"{sum(counts[e]['count'] for e in VECTOR_OPS) / max(row['iterations'], 1):.1f} vector ops per "
+              f"iteration", flush=True)
+    common.save_rows(path, rows)
+    problem.destroy()
+
+
+def find(rows, **key):
+    found = [r for r in rows if all(r.get(k) == v for k, v in key.items())]
+    return found[0] if found else None
+
+
+def grid_table(rows):
+    header = ["N", "p*", "solver", "control", "variant", "its", "FFT pairs", "s", "ms/pair", "x PK time",
+              "x PK ms/pair", "load/disp pairs", "natural", "load err", "reason"]
+    lines = []
+    for r in sorted(rows, key=lambda r: (r["N"], r["pstar"], r["solver"] != "pk", r["solver"], r["control"],
+                                         r["variant"] != "before")):
+        pk = find(rows, N=r["N"], pstar=r["pstar"], solver="pk", control=r["control"])
+        disp = find(rows, N=r["N"], pstar=r["pstar"], solver=r["solver"], control="displacement",
+                    variant=r["variant"])
+        ratio = f"{r['pairs'] / disp['pairs']:.2f}" if r["control"] == "load" and disp else ""
+        load_error = "" if r["load_error"] is None else f"{r['load_error']:.1e}"
+        lines.append([r["N"], r["pstar"], r["solver"], r["control"], r["variant"], r["iterations"], r["pairs"],
+                      f"{r['seconds']:.2f}", f"{r['ms_per_pair']:.1f}", f"{r['seconds'] / pk['seconds']:.2f}",
+                      f"{r['ms_per_pair'] / pk['ms_per_pair']:.2f}", ratio, f"{r['natural']:.1e}", load_error,
+                      r["reason"]])
+    return common.markdown_table(header, lines)
+
+
+def profile_table(profile):
+    header = ["solver", "its", "FFT pairs", "s", "ms/pair"] + [e for e in VECTOR_OPS] + \
+             ["vector ops/it", "s in vector ops", "s in FFT pairs", "s in our test", "s in our H0"]
+    lines = []
+    for r in profile:
+        events = r["events"]
+        its = max(r["iterations"], 1)
+        vector_ops = sum(events[e][0] for e in VECTOR_OPS)
+        lines.append([f"{r['solver']} ({r['variant']})", r["iterations"], r["pairs"], f"{r['seconds']:.2f}",
+                      f"{r['ms_per_pair']:.1f}"] + [f"{events[e][0] / its:.1f}" for e in VECTOR_OPS] +
+                     [f"{vector_ops / its:.1f}", f"{sum(events[e][1] for e in VECTOR_OPS):.2f}",
+                      f"{events['RPFFTPair'][1]:.2f}", f"{events['RPBoundTest'][1] + events['RPKKTCheck'][1]:.2f}",
+                      f"{events['RPBoundH0'][1]:.2f}"])
+    return common.markdown_table(header, lines)
+
+
+def plot(rows, folder):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    pstars = sorted({r["pstar"] for r in rows})
+    sizes = sorted({r["N"] for r in rows})
+    fig, axes = plt.subplots(2, len(pstars), figsize=(4.2 * len(pstars), 7), squeeze=False)
+    series = sorted({(r["solver"], r["control"], r["variant"]) for r in rows})
+    colors = {solver: f"C{i}" for i, solver in enumerate(sorted({s for s, _, _ in series}))}
+    handles = {}
+    for column, pstar in enumerate(pstars):
+        for solver, control, variant in series:
+            chosen = sorted((r for r in rows if (r["pstar"], r["solver"], r["control"], r["variant"]) ==
+                             (pstar, solver, control, variant)), key=lambda r: r["N"])
+            if not chosen:
+                continue
+            label = f"{solver} {control[:4]}" + (" (before)" if variant == "before" else "")
+            style = dict(color=colors[solver], marker="o" if control == "load" else "s",
+                         linestyle="-" if control == "load" else "--", fillstyle="full" if variant == "after" else "none")
+            n = [r["N"] for r in chosen]
+            handles[label], = axes[0, column].plot(n, [r["pairs"] for r in chosen], label=label, **style)
+            axes[1, column].plot(n, [r["seconds"] for r in chosen], label=label, **style)
+        axes[0, column].set_title(f"p* = {pstar}")
+        for row, quantity in enumerate(("FFT pairs", "seconds")):
+            axes[row, column].set(xscale="log", yscale="log", xlabel="N", ylabel=quantity)
+            axes[row, column].minorticks_off()
+            axes[row, column].set_xticks(sizes, [str(n) for n in sizes])
+    axes[0, -1].legend(handles.values(), handles.keys(), fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    return common.save_figure(fig, folder, "tao_speed.png")
+
+
+def report(rows, profile, folder):
+    lines = ["# TAO bound types against Polonsky-Keer, before and after issue 40", "",
+             "Generated by `OPENBLAS_NUM_THREADS=1 .venv/bin/python studies/tao_speed.py --report` (group #1 "
+             "surface, seed 1, natural KKT residual 1e-8, cold starts, FFTW_MEASURE plans from the wisdom cache). "
+             "FFT pairs are deterministic; seconds come from one run on a shared machine whose load average "
+             "was 10 to 13 on 2 cores, so every ratio is of one run. `x PK time`, `x PK ms/pair`: against "
+             "Polonsky-Keer under the same control, N and p*; `load/disp pairs`: the load-controlled solve's "
+             "pairs over the same solver's displacement-controlled ones. `before`: -tao_type X as it was (a "
+             "root find on d under load control); `after`: `fast_X` of roughpetsc/solvers/bound_load.py. "
+             "`before` was measured at N = 512, p* = 0.5 only (each root-find solve costs minutes at 1024); GPCG "
+             "under load control stalls after 1-2 inner solves at p* >= 0.5 (its projected search, as in the "
+             "residual floors of tao_floors.py) and was not rerun at N = 1024 (`--solvers blmvm bqnls tron`).", ""]
+    if rows:
+        lines += ["## Every solve", "", grid_table(rows), "", f"![time and pairs]({plot(rows, folder)})", ""]
+    if profile:
+        lines += [f"## Where the time goes: displacement control, N = {profile[0]['N']}, p* = 0.5", "",
+                  "Vector operations per iteration by PETSc event (-log_view counts read through petsc4py), "
+                  "and seconds in them, in FFT pairs and in our callbacks.", "", profile_table(profile), ""]
+    with open(os.path.join(folder, "tao_speed.md"), "w") as f:
+        f.write("\n".join(lines))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[512, 1024])
+    parser.add_argument("--pstars", type=float, nargs="+", default=[0.05, 0.5, 2.0])
+    parser.add_argument("--solvers", nargs="+", default=["blmvm", "bqnls", "gpcg", "tron"])
+    parser.add_argument("--variants", nargs="+", default=["after"], choices=["after", "before"])
+    parser.add_argument("--max-time", type=float, default=600.0)
+    parser.add_argument("--profile", type=int, default=0, help="N of the -log_view breakdown (0: none)")
+    args, path, rows = common.start_resumable(parser, OUT, "tao_speed", "write tao_speed.md and the plot only")
+    profile_path = os.path.join(OUT, "tao_speed_profile.json")
+    if args.report:
+        report(rows, common.load_rows(profile_path), OUT)
+        return
+    start = time.perf_counter()
+    if args.profile:
+        run_profile(args.profile, profile_path, args.max_time)
+    else:
+        run_grid(args, path, rows)
+    print(f"done in {time.perf_counter() - start:.0f} s")
+
+
+if __name__ == "__main__":
+    main()
