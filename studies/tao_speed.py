@@ -6,9 +6,12 @@
 Group #1 surface (seed 1), natural KKT residual 1e-8, FFTW_MEASURE plans remembered in the wisdom cache (so the
 iterates repeat from the second run of a size on). Per N and p*: Polonsky-Keer (the default solver) under load
 control gives the separation d; every solver then solves the load (``pstar``) and the QP at d, cold. Variants:
-``before``, the backends of roughpetsc/solvers/bound_qp.py and root_find.py (a root find on d around each
-type); ``after``, those of roughpetsc/solvers/bound_load.py (``fast_<type>``: the augmented Lagrangian on
-mean(p) = pbar, the Fourier initial Hessian of the quasi-Newton types, fused callbacks). ``--profile N``
+``after``, ``-tao_type <type>`` as it is (roughpetsc/solvers/bound_qp.py: the augmented Lagrangian on
+mean(p) = pbar, the Fourier initial Hessian of the quasi-Newton types, fused callbacks); ``before``, the
+former methods as options still select them (``-bound_load rootfind -bound_h0 none``: a root find on d around
+each type, PETSc's initial Hessian). The ``before`` rows of the committed tao_speed.json and the profile were
+measured on the code before these changes (commit 4c0fa30: unfused callbacks too), so they show the whole
+gain; a rerun of ``before`` now measures the former methods with the fused callbacks. ``--profile N``
 counts PETSc's vector operations and times our events per iteration for PK, BLMVM and BQNLS under
 displacement control at N, p* = 0.5 (the -log_view breakdown, read through petsc4py's log).
 
@@ -34,28 +37,26 @@ PROFILED_EVENTS = ("VecDot", "VecNorm", "VecScale", "VecCopy", "VecSet", "VecAXP
 VECTOR_OPS = [e for e in PROFILED_EVENTS if e.startswith("Vec")]
 
 
-def backend_name(solver, variant):
-    if solver == "pk":
-        return None
-    return solver if variant == "before" else "fast_" + solver
+# The options that select the former methods (variant "before").
+BEFORE = {"bound_load": "rootfind", "bound_h0": "none"}
 
 
 def problem_for(n):
     from petsc4py import PETSc
 
-    from roughpetsc import fftw
+    from roughpetsc.fft import plans
 
-    with fftw.remembered_plans(PETSc.COMM_WORLD.tompi4py(), fftw.default_wisdom_path(), "FFTW_MEASURE"):
+    with plans.remembered_plans(PETSc.COMM_WORLD.tompi4py(), plans.default_wisdom_path(), "FFTW_MEASURE"):
         return common.group1_problem(n, effort="FFTW_MEASURE")
 
 
 def one_solve(problem, solver, variant, control, pstar, separation, max_time):
     """One cold solve; a row of the table."""
-    import roughpetsc.solvers.bound_load  # noqa: F401  (registers the fast_<type> backends)
-
     options = {"solve_max_time": str(max_time)}
     if solver != "pk":
-        options["tao_type"] = backend_name(solver, variant)
+        options["tao_type"] = solver
+        if variant == "before":
+            options.update(BEFORE)
     load = {"pstar": pstar} if control == "load" else {"gbar": separation}
     result, _, seconds = common.solve(problem, options, 1e-8, control=control, **load)
     return {"iterations": result.iterations, "pairs": result.operator_applications,
@@ -209,7 +210,7 @@ def report(rows, profile, folder):
              "was 10 to 13 on 2 cores, so every ratio is of one run. `x PK time`, `x PK ms/pair`: against "
              "Polonsky-Keer under the same control, N and p*; `load/disp pairs`: the load-controlled solve's "
              "pairs over the same solver's displacement-controlled ones. `before`: -tao_type X as it was (a "
-             "root find on d under load control); `after`: `fast_X` of roughpetsc/solvers/bound_load.py. "
+             "root find on d under load control, measured on the code before the change, commit 4c0fa30); `after`: `-tao_type X` as it is now (roughpetsc/solvers/bound_qp.py). "
              "`before` was measured at N = 512, p* = 0.5 only (each root-find solve costs minutes at 1024); GPCG "
              "under load control stalls after 1-2 inner solves at p* >= 0.5 (its projected search, as in the "
              "residual floors of tao_floors.py) and was not rerun at N = 1024 (`--solvers blmvm bqnls tron`).", ""]

@@ -47,7 +47,7 @@ def reference():
 
 @pytest.mark.parametrize("tao_type", ["blmvm", "bqnls", "tron", "gpcg"])
 @pytest.mark.parametrize("control", ["load", "displacement"])
-def test_fast_backend_reaches_the_pk_pressure(reference, tao_type, control):
+def test_bound_type_reaches_the_pk_pressure(reference, tao_type, control):
     problem, pk, pressure = reference
     solver = Solver(problem, control, tao_type, 1e-8)
     try:
