@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import petsc4py
+import pytest
 
 # Every test plans its transforms afresh, as on a new machine: no wisdom from earlier runs.
 # ROUGHPETSC_FFT_EFFORT (FFTW_ESTIMATE, FFTW_MEASURE, FFTW_PATIENT) forces one planner effort on the
@@ -77,3 +78,38 @@ def applications_at_time_limit(monkeypatch, problem):
 
     monkeypatch.setattr(stopping.History, "out_of_time", recorded)
     return at_limit
+
+
+def fractal_problem(n=64, k_l=4, k_s=16, seed=3, **options):
+    """The small test problem: a fractal surface (H = 0.8, m2 = 2e-4) on an n x n unit cell, E* = 1, one rank,
+    FFTW_ESTIMATE plans; ``options`` go to ContactProblem (boundary, hardness). Destroy it after use."""
+    from petsc4py import PETSc
+
+    from roughpetsc import ContactProblem, Grid, fractal
+
+    grid = Grid(n, n)
+    return ContactProblem(grid, fractal(grid, k_l, k_s, 0.8, 2e-4, seed), 1.0, PETSc.COMM_SELF,
+                          fft_effort="FFTW_ESTIMATE", **options)
+
+
+@pytest.fixture(scope="module")
+def small_problem():
+    """:func:`fractal_problem` with its defaults (64^2, k_l = 4, k_s = 16), shared by the tests of a module."""
+    problem = fractal_problem()
+    yield problem
+    problem.destroy()
+
+
+def error_lines(out):
+    return [line for line in out.stderr.splitlines() if line.startswith("roughpetsc: error")]
+
+
+def assert_one_clear_error(out, *named):
+    """Exit status 2, no traceback, exactly one ``roughpetsc: error`` line naming every string of ``named``."""
+    assert out.returncode == 2, out.stderr
+    assert "Traceback" not in out.stderr
+    errors = error_lines(out)
+    assert len(errors) == 1, out.stderr
+    for text in named:
+        assert str(text) in errors[0], errors[0]
+    return errors[0]

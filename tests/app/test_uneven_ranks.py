@@ -57,6 +57,8 @@ def one_rank(tmp_path_factory):
     return {effort: solve(folder, 1, ["-fft_effort", effort]) for effort in ("FFTW_ESTIMATE", "FFTW_MEASURE")}
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 @pytest.mark.parametrize("effort", ["FFTW_ESTIMATE", "FFTW_MEASURE"])
 @pytest.mark.parametrize("ranks", [3, 4])
 def test_uneven_rows_equal_one_rank(tmp_path, one_rank, ranks, effort):
@@ -71,6 +73,8 @@ def test_planner_efforts_agree(one_rank):
     assert max(measured.values()) <= TOLERANCE, measured
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_displacement_control_on_three_ranks(tmp_path):
     """Displacement control (the mean-mode term of the preconditioner, global sums over uneven blocks)."""
     common = ["-surface_N", 66, "-surface_N0", 62, "-surface_ks", 16, "-surface_kl", 4, "-kkt_rtol", 1e-13,
@@ -84,6 +88,8 @@ def test_displacement_control_on_three_ranks(tmp_path):
         assert steps[3][key] == pytest.approx(steps[1][key], rel=TOLERANCE), key
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_tao_bound_solver_on_four_ranks(tmp_path):
     """A TAO bound solver with the Fourier preconditioner on the free set (createSubMatrix on uneven blocks).
 
@@ -101,6 +107,7 @@ def test_tao_bound_solver_on_four_ranks(tmp_path):
     assert steps[4]["gbar"] == pytest.approx(steps[1]["gbar"], rel=1e-6)
 
 
+@pytest.mark.mpi
 def test_more_ranks_than_rows_is_refused_by_name(tmp_path):
     out = run_cli(["-surface_N", 16, "-surface_N0", 3, "-surface_ks", 4, "-surface_kl", 2], ranks=4, timeout=120)
     assert out.returncode == 2, out.stdout + out.stderr
@@ -108,6 +115,8 @@ def test_more_ranks_than_rows_is_refused_by_name(tmp_path):
     assert len(errors) == 1 and "-surface_N0/-surface_N" in errors[0], out.stderr
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_ensemble_group_of_three_ranks_equals_one_rank(tmp_path):
     """An ensemble group solves each surface on its own communicator: uneven rows there too."""
     common = ["-mode", "ensemble", "-surface_N", 62, "-surface_ks", 16, "-surface_kl", 4, "-ensemble_size", 2,

@@ -170,6 +170,8 @@ problem.destroy()
 """
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_two_and_three_ranks_equal_one_rank(tmp_path):
     script = tmp_path / "ranks.py"
     script.write_text(RANKS_SCRIPT)
@@ -191,6 +193,7 @@ def test_two_and_three_ranks_equal_one_rank(tmp_path):
         assert np.abs(other["pressure"] - answers[0]["pressure"]).max() < 1e-9 * scale
 
 
+@pytest.mark.mpi
 def test_command_line_cycle_on_two_ranks_equals_one_rank(tmp_path):
     """-adhesion with -gbar_list: approach and retraction, the HDF5 record, 2 ranks equal to 1.
 
@@ -372,6 +375,7 @@ def test_penny_shaped_adhesive_crack_meets_the_maugis_dugdale_crack():
     assert min(p for p, _, _ in states) > sigma  # every crack is open above E (6.38)
 
 
+@pytest.mark.slow
 def test_dugdale_wave_tends_to_johnsons_jkr_wave():
     """Johnson's wave at alpha = 0.3 with a short Dugdale range (h0 = 0.03 h, Maugis's lambda 6.4 at the crest):
     the JKR limit. The contact half-width against the load follows Johnson's pbar = p* (sin^2 psi - alpha
@@ -395,6 +399,7 @@ def test_dugdale_wave_tends_to_johnsons_jkr_wave():
     assert abs(snap_off - jkr_pulloff_displacement_control(1.0, amplitude, 1.0, work)[2]) < 0.02 * amplitude + step
 
 
+@pytest.mark.slow
 def test_tao_almm_stops_within_a_line_search_of_its_time_limit(monkeypatch):
     """The time limit ends ALMM's subsolve (a zero gradient left the augmented Lagrangian's constraint term)."""
     grid = Grid(256, 256, 1.0, 1.0)

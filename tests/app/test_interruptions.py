@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from conftest import MPI_ENV, ROOT, run_cli, run_on_terminal
-from test_newcomer import assert_one_clear_error
+from conftest import assert_one_clear_error
 
 TINY = ["-surface_N", 32, "-surface_ks", 8, "-surface_kl", 2, "-fft_effort", "FFTW_ESTIMATE"]
 
@@ -54,6 +54,7 @@ def test_resume_with_other_load_kind_is_refused(saved_path):
     assert_one_clear_error(out, "-resume", "differs at step 1: pbar 0.001 here, pstar 0.1 in the file")
 
 
+@pytest.mark.mpi
 def test_resume_with_a_longer_list_extends_the_path(saved_path):
     before = saved_steps(saved_path)
     # Its own -json is rewritten without -overwrite.
@@ -109,6 +110,7 @@ def interrupt_after(run, marker, count):
     return "".join(seen) + rest, stderr
 
 
+@pytest.mark.mpi
 @pytest.mark.parametrize("ranks, fields", [(1, "last"), (2, "all"), (2, "last")])
 def test_an_interrupted_path_holds_every_step_it_printed(tmp_path, ranks, fields):
     """`timeout -s INT 5 mpiexec -n 2 ... -output_fields all` once printed 8 converged steps and kept 4, silently."""
@@ -173,6 +175,7 @@ def test_output_into_a_pipe_closed_early_ends_quietly(tmp_path):
 PROGRESS = TINY + ["-pstar_list", "0.2,0.4", "-progress_interval", 1e-9]
 
 
+@pytest.mark.mpi
 def test_progress_on_a_terminal_behind_mpiexec(tmp_path):
     command = ["mpiexec", "-n", "2", "--oversubscribe", sys.executable, "-m", "roughpetsc", *map(str, PROGRESS)]
     status, printed = run_on_terminal(command, tmp_path)
@@ -180,6 +183,7 @@ def test_progress_on_a_terminal_behind_mpiexec(tmp_path):
     assert "... step 2 of 2 (pstar 0.4): inner solve 1, iteration" in printed
 
 
+@pytest.mark.mpi
 def test_no_progress_into_a_log_under_mpiexec(tmp_path):
     """Open MPI gives each rank a terminal: isatty() is true there, yet mpiexec writes into a pipe or a file."""
     out = run_cli(PROGRESS, ranks=2)

@@ -113,6 +113,8 @@ def run_driver(ranks, tmp_path):
     return subprocess.run(command, capture_output=True, text=True, env=env, timeout=300, cwd=ROOT)
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 @pytest.mark.parametrize("ranks", [1, 2, 3, 4])
 def test_slab_pair_matches_numpy(ranks, tmp_path):
     done = run_driver(ranks, tmp_path)
@@ -129,6 +131,7 @@ def test_block_split_is_balanced():
     assert list(counts) == [21, 21, 20] and list(starts) == [0, 21, 42]
 
 
+@pytest.mark.mpi
 def test_fewer_rows_than_ranks_is_refused_by_name():
     with pytest.raises(ParameterError, match="fewer than the 4 MPI ranks") as refused:
         row_split(3, 4)

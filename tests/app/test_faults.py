@@ -54,6 +54,8 @@ def _digest(path):
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_disk_full_during_an_ensemble_stops_with_one_message_and_keeps_the_file(small_disk):
     output = small_disk / "run.h5"
     command = ["mpiexec", "-n", "2", "--oversubscribe", sys.executable, "-m", "roughpetsc",
@@ -78,6 +80,8 @@ def test_disk_full_during_an_ensemble_stops_with_one_message_and_keeps_the_file(
         assert ensemble.read(output)["@n_finished"] == 6
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_read_only_folder_refuses_before_work_and_leaves_the_file(small_disk):
     output = small_disk / "run.h5"
     first = run_cli(ARGS + ["-ensemble_size", 2, "-output", output], ranks=2)

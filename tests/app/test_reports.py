@@ -9,7 +9,7 @@ import subprocess
 import pytest
 
 from conftest import ROOT, run_cli
-from test_newcomer import assert_one_clear_error
+from conftest import assert_one_clear_error
 
 TINY = ["-surface_N", 32, "-surface_ks", 8, "-surface_kl", 2, "-fft_effort", "FFTW_ESTIMATE"]
 
