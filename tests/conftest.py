@@ -30,14 +30,44 @@ MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
            "OMPI_MCA_rmaps_base_oversubscribe": "1", "OMPI_MCA_btl_vader_single_copy_mechanism": "none"}
 
 
-def run_cli(args, ranks=1, cwd=None, timeout=600):
+# Every subprocess of a test (mpiexec included) has this much time: the longest takes about 90 s on a 2-core
+# machine loaded by two suites at once, so reaching it means a hang, and the failure says which command hung.
+SUBPROCESS_TIMEOUT = 900
+
+
+def timed_out(command, error):
+    """Fail the test with the command that did not finish within its time."""
+    shown = command if isinstance(command, str) else " ".join(str(part) for part in command)
+    pytest.fail(f"timed out after {error.timeout:g} s (a hang: no loaded machine takes this long): {shown}",
+                pytrace=False)
+
+
+def run_process(command, timeout=SUBPROCESS_TIMEOUT, **kwargs):
+    """``subprocess.run(command, capture_output=True, text=True, **kwargs)``; a timeout fails the test by name."""
+    try:
+        return subprocess.run(command, capture_output=True, text=True, timeout=timeout, **kwargs)
+    except subprocess.TimeoutExpired as error:
+        timed_out(command, error)
+
+
+def finish(process, command, timeout=SUBPROCESS_TIMEOUT):
+    """``process.communicate()`` within ``timeout``; a timeout kills it and fails the test naming ``command``."""
+    try:
+        return process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired as error:
+        process.kill()
+        process.communicate()
+        timed_out(command, error)
+
+
+def run_cli(args, ranks=1, cwd=None):
     """Run ``python -m roughpetsc args`` on ``ranks`` MPI ranks; returns the CompletedProcess."""
     command = [sys.executable, "-m", "roughpetsc", *[str(a) for a in args]]
     if ranks > 1:
         command = ["mpiexec", "-n", str(ranks), "--oversubscribe", *command]
     env = dict(os.environ, **MPI_ENV)
     env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
-    return subprocess.run(command, capture_output=True, text=True, cwd=cwd or ROOT, env=env, timeout=timeout)
+    return run_process(command, cwd=cwd or ROOT, env=env)
 
 
 def run_on_terminal(command, cwd=None):
@@ -57,7 +87,8 @@ def run_on_terminal(command, cwd=None):
             break
         printed += chunk
     os.close(primary)
-    return run.wait(timeout=300), printed.decode()
+    finish(run, command)
+    return run.returncode, printed.decode()
 
 
 def applications_at_time_limit(monkeypatch, problem):

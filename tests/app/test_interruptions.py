@@ -12,7 +12,7 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import MPI_ENV, ROOT, run_cli, run_on_terminal
+from conftest import MPI_ENV, ROOT, finish, run_cli, run_on_terminal, run_process
 from conftest import assert_one_clear_error
 
 TINY = ["-surface_N", 32, "-surface_ks", 8, "-surface_kl", 2, "-fft_effort", "FFTW_ESTIMATE"]
@@ -106,7 +106,7 @@ def interrupt_after(run, marker, count):
     run.send_signal(signal.SIGINT)
     # Read on through run.stdout: communicate() would read the pipe past what readline() has buffered.
     rest, stderr = run.stdout.read(), run.stderr.read()
-    run.wait(timeout=300)
+    finish(run, run.args)
     return "".join(seen) + rest, stderr
 
 
@@ -162,8 +162,7 @@ def test_output_into_a_pipe_closed_early_ends_quietly(tmp_path):
     loads = ",".join(f"{0.05 * k:g}" for k in range(1, 21))
     command = (f"{sys.executable} -m roughpetsc {' '.join(map(str, TINY))} -pstar_list {loads} -json p.json "
                "| head -n 2; exit ${PIPESTATUS[0]}")
-    out = subprocess.run(["bash", "-c", command], capture_output=True, text=True, cwd=tmp_path, timeout=300,
-                         env=dict(os.environ, PYTHONPATH=ROOT))
+    out = run_process(["bash", "-c", command], cwd=tmp_path, env=dict(os.environ, PYTHONPATH=ROOT))
     assert out.returncode == 0, out.stderr
     assert len(out.stdout.splitlines()) == 2
     assert "PETSC ERROR" not in out.stderr and "BrokenPipe" not in out.stderr, out.stderr

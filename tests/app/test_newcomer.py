@@ -7,13 +7,12 @@ import hashlib
 import json
 import os
 import stat
-import subprocess
 import sys
 
 import h5py
 import pytest
 
-from conftest import ROOT, assert_one_clear_error, error_lines, run_cli
+from conftest import ROOT, assert_one_clear_error, error_lines, run_cli, run_process
 
 SMALL = ["-surface_N", 64, "-surface_ks", 16, "-surface_kl", 4]
 
@@ -135,7 +134,7 @@ BAD_OUTPUTS = [
 @pytest.mark.mpi
 @pytest.mark.parametrize("args, named", BAD_OUTPUTS)
 def test_bad_outputs_on_two_ranks_end_with_one_message(tmp_path, args, named):
-    out = run_cli(args(tmp_path), ranks=2, timeout=120)  # a hang fails here as TimeoutExpired
+    out = run_cli(args(tmp_path), ranks=2)  # a hang fails here as TimeoutExpired
     assert out.returncode != 0
     assert "Traceback" not in out.stderr
     errors = error_lines(out)
@@ -197,7 +196,7 @@ def test_a_missing_options_file_is_named(tmp_path):
 @pytest.mark.mpi
 @pytest.mark.parametrize("size", [32768, 100000])
 def test_a_grid_too_large_for_memory_is_refused_up_front(size):
-    out = run_cli(["-surface_N", size], timeout=60)
+    out = run_cli(["-surface_N", size])
     message = assert_one_clear_error(out, "-surface_N", f"{size}x{size}", "GiB", "available")
     assert out.stdout == ""
     assert message
@@ -235,8 +234,7 @@ def test_help_prints_our_options_and_presets_before_petsc(tmp_path):
 def test_help_into_a_pager_that_stops_early_ends_quietly():
     """`-help | head` closes the pipe while help is still printing: no PETSc crash banner."""
     command = f"{sys.executable} -m roughpetsc -help | head -n 2"
-    out = subprocess.run(["bash", "-c", command], capture_output=True, text=True, cwd=ROOT, timeout=120,
-                         env=dict(os.environ, PYTHONPATH=ROOT))
+    out = run_process(["bash", "-c", command], cwd=ROOT, env=dict(os.environ, PYTHONPATH=ROOT))
     assert out.stdout.startswith("roughpetsc options")
     assert "PETSC ERROR" not in out.stderr and "MPI_ABORT" not in out.stderr, out.stderr
 

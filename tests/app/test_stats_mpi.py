@@ -2,13 +2,11 @@
 
 import json
 import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
-from conftest import ROOT, run_cli
+from conftest import ROOT, run_cli, run_process
 from roughpetsc import ensemble
 from roughpetsc.surface import seeds
 from roughpetsc.store import stats_file
@@ -39,7 +37,7 @@ def run_stats(ranks, arguments, tmp_path):
     driver = tmp_path / "driver.py"
     driver.write_text(DRIVER)
     command = ["mpiexec", "-n", str(ranks), "--oversubscribe", PYTHON, str(driver)] + arguments
-    return subprocess.run(command, capture_output=True, text=True, env=environment, timeout=120, cwd=ROOT)
+    return run_process(command, env=environment, cwd=ROOT)
 
 
 def stats_json(ranks, arguments, tmp_path):
@@ -191,7 +189,7 @@ def test_a_library_error_on_one_rank_stops_every_rank(tmp_path):
                        ONE_RANK_FAILS_OUT=str(tmp_path / "error"))
     command = ["mpiexec", "-n", "2", "--oversubscribe", PYTHON, str(driver), "-surface_N", "32",
                "-surface_kl", "2", "-surface_ks", "8", "-ensemble_seed", "3", "-stats_ensemble", "2"]
-    result = subprocess.run(command, capture_output=True, text=True, env=environment, timeout=60, cwd=ROOT)
+    result = run_process(command, env=environment, cwd=ROOT)
     assert result.returncode == 2, result.stderr
     for rank in (0, 1):  # the message of rank 1's error, raised on both ranks
         message = (tmp_path / f"error.rank{rank}").read_text()

@@ -10,7 +10,6 @@ import contextlib
 import json
 import math
 import os
-import subprocess
 import sys
 
 import numpy as np
@@ -18,7 +17,7 @@ import pytest
 
 import h5py
 
-from conftest import MPI_ENV, ROOT, applications_at_time_limit, run_cli
+from conftest import MPI_ENV, ROOT, applications_at_time_limit, run_cli, run_process
 from roughpetsc.contact import AdhesiveProblem, approach_retraction, dissipated_energy
 from roughpetsc.solvers import Solver, drive
 from roughpetsc.contact.problem import ContactProblem
@@ -183,7 +182,7 @@ def test_two_and_three_ranks_equal_one_rank(tmp_path):
         command = [sys.executable, str(script), str(out)]
         if ranks > 1:
             command = ["mpiexec", "-n", str(ranks), "--oversubscribe", *command]
-        run = subprocess.run(command, capture_output=True, text=True, env=env, timeout=300)
+        run = run_process(command, env=env)
         assert run.returncode == 0, run.stdout + run.stderr
         answers.append(np.load(out))
     for other in answers[1:]:
@@ -206,7 +205,7 @@ def test_command_line_cycle_on_two_ranks_equals_one_rank(tmp_path):
     runs = []
     for ranks in (1, 2):
         path = tmp_path / f"cycle{ranks}.h5"
-        out = run_cli(args + ["-output", path], ranks=ranks, timeout=120)
+        out = run_cli(args + ["-output", path], ranks=ranks)
         assert out.returncode == 0, out.stdout + out.stderr
         assert "Tabor parameter" in out.stdout
         with h5py.File(path) as f:
@@ -225,7 +224,7 @@ def test_command_line_cycle_reports_its_dissipated_energy(tmp_path):
     path = tmp_path / "cycle.h5"
     out = run_cli(["-surface_N", 48, "-surface_ks", 12, "-surface_kl", 2, "-adhesion", "exponential",
                    "-adhesion_work", 2e-7, "-adhesion_range", 2e-5, "-gbar_list", "2e-4,1e-4,5e-5,1e-4,2e-4",
-                   "-fft_effort", "FFTW_ESTIMATE", "-output", path], timeout=120)
+                   "-fft_effort", "FFTW_ESTIMATE", "-output", path])
     assert out.returncode == 0, out.stdout + out.stderr
     assert "energy dissipated per unit area" in out.stdout
     with h5py.File(path) as f:

@@ -132,7 +132,7 @@ def test_free_boundary_on_several_ranks_equals_one_rank(tmp_path, ranks):
     fields = []
     for count in (1, ranks):
         path = tmp_path / f"free{count}.h5"
-        out = run_cli(args + ["-output", path], ranks=count, timeout=120)
+        out = run_cli(args + ["-output", path], ranks=count)
         assert out.returncode == 0, out.stdout + out.stderr
         with h5py.File(path) as f:
             fields.append(f["pressure"][()])

@@ -123,7 +123,7 @@ def test_hardness_on_two_ranks_equals_one_rank(tmp_path):
     fields, plastic = [], []
     for ranks in (1, 2):
         path = tmp_path / f"cap{ranks}.h5"
-        out = run_cli(args + ["-output", path], ranks=ranks, timeout=120)
+        out = run_cli(args + ["-output", path], ranks=ranks)
         assert out.returncode == 0, out.stdout + out.stderr
         with h5py.File(path) as f:
             fields.append(f["pressure"][()])

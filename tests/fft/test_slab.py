@@ -6,7 +6,6 @@ counts that they do not divide.
 """
 
 import os
-import subprocess
 import sys
 
 import numpy as np
@@ -17,7 +16,7 @@ from roughpetsc.fft.slab import SlabTransform
 from roughpetsc.parallel import block_split, row_split
 from roughpetsc.surface.grid import Grid
 
-from conftest import MPI_ENV, ROOT
+from conftest import MPI_ENV, ROOT, run_process
 
 # Run under mpiexec: every rank checks its part against numpy on the whole array.
 DRIVER = r"""
@@ -110,7 +109,7 @@ def run_driver(ranks, tmp_path):
     env = dict(os.environ, **MPI_ENV)
     env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
     command = ["mpiexec", "-n", str(ranks), "--oversubscribe", sys.executable, str(driver)]
-    return subprocess.run(command, capture_output=True, text=True, env=env, timeout=300, cwd=ROOT)
+    return run_process(command, env=env, cwd=ROOT)
 
 
 @pytest.mark.mpi

@@ -12,7 +12,7 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import MPI_ENV, ROOT, run_cli
+from conftest import MPI_ENV, ROOT, SUBPROCESS_TIMEOUT, run_cli
 from roughpetsc import ensemble
 from roughpetsc.contact import loads
 from roughpetsc.errors import UserError
@@ -191,7 +191,7 @@ def test_kill_and_resume_gives_the_same_file(tmp_path):
     process = subprocess.Popen(command, cwd=ROOT, env=env, start_new_session=True, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)
     try:
-        deadline = time.time() + 300
+        deadline = time.time() + SUBPROCESS_TIMEOUT
         while process.poll() is None and time.time() < deadline and _finished(killed) < 1:
             time.sleep(0.02)
         assert process.poll() is None, "the run ended before it could be killed"

@@ -11,7 +11,7 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import MPI_ENV, ROOT, run_cli, run_on_terminal
+from conftest import MPI_ENV, ROOT, finish, run_cli, run_on_terminal
 
 SMALL = ["-surface_N", 64, "-surface_ks", 16, "-surface_kl", 4]
 PATH = ["-pstar_list", "0.2,0.5,1"]
@@ -107,7 +107,7 @@ def test_ctrl_c_keeps_the_finished_steps_and_resume_completes_the_path(tmp_path)
     while not output.exists() and run.poll() is None:  # the first step is saved
         time.sleep(0.01)
     run.send_signal(signal.SIGINT)
-    _, stderr = run.communicate(timeout=120)
+    _, stderr = finish(run, command)
     assert run.returncode == 130, stderr
     assert "Traceback" not in stderr and "rerun with -resume" in stderr
     finished = steps_of(output)
