@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import petsc4py
+import pytest
 
 # Every test plans its transforms afresh, as on a new machine: no wisdom from earlier runs.
 # ROUGHPETSC_FFT_EFFORT (FFTW_ESTIMATE, FFTW_MEASURE, FFTW_PATIENT) forces one planner effort on the
@@ -29,14 +30,44 @@ MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
            "OMPI_MCA_rmaps_base_oversubscribe": "1", "OMPI_MCA_btl_vader_single_copy_mechanism": "none"}
 
 
-def run_cli(args, ranks=1, cwd=None, timeout=600):
+# Every subprocess of a test (mpiexec included) has this much time: the longest takes about 90 s on a 2-core
+# machine loaded by two suites at once, so reaching it means a hang, and the failure says which command hung.
+SUBPROCESS_TIMEOUT = 900
+
+
+def timed_out(command, error):
+    """Fail the test with the command that did not finish within its time."""
+    shown = command if isinstance(command, str) else " ".join(str(part) for part in command)
+    pytest.fail(f"timed out after {error.timeout:g} s (a hang: no loaded machine takes this long): {shown}",
+                pytrace=False)
+
+
+def run_process(command, timeout=SUBPROCESS_TIMEOUT, **kwargs):
+    """``subprocess.run(command, capture_output=True, text=True, **kwargs)``; a timeout fails the test by name."""
+    try:
+        return subprocess.run(command, capture_output=True, text=True, timeout=timeout, **kwargs)
+    except subprocess.TimeoutExpired as error:
+        timed_out(command, error)
+
+
+def finish(process, command, timeout=SUBPROCESS_TIMEOUT):
+    """``process.communicate()`` within ``timeout``; a timeout kills it and fails the test naming ``command``."""
+    try:
+        return process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired as error:
+        process.kill()
+        process.communicate()
+        timed_out(command, error)
+
+
+def run_cli(args, ranks=1, cwd=None):
     """Run ``python -m roughpetsc args`` on ``ranks`` MPI ranks; returns the CompletedProcess."""
     command = [sys.executable, "-m", "roughpetsc", *[str(a) for a in args]]
     if ranks > 1:
         command = ["mpiexec", "-n", str(ranks), "--oversubscribe", *command]
     env = dict(os.environ, **MPI_ENV)
     env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
-    return subprocess.run(command, capture_output=True, text=True, cwd=cwd or ROOT, env=env, timeout=timeout)
+    return run_process(command, cwd=cwd or ROOT, env=env)
 
 
 def run_on_terminal(command, cwd=None):
@@ -56,7 +87,8 @@ def run_on_terminal(command, cwd=None):
             break
         printed += chunk
     os.close(primary)
-    return run.wait(timeout=300), printed.decode()
+    finish(run, command)
+    return run.returncode, printed.decode()
 
 
 def applications_at_time_limit(monkeypatch, problem):
@@ -77,3 +109,38 @@ def applications_at_time_limit(monkeypatch, problem):
 
     monkeypatch.setattr(stopping.History, "out_of_time", recorded)
     return at_limit
+
+
+def fractal_problem(n=64, k_l=4, k_s=16, seed=3, **options):
+    """The small test problem: a fractal surface (H = 0.8, m2 = 2e-4) on an n x n unit cell, E* = 1, one rank,
+    FFTW_ESTIMATE plans; ``options`` go to ContactProblem (boundary, hardness). Destroy it after use."""
+    from petsc4py import PETSc
+
+    from roughpetsc import ContactProblem, Grid, fractal
+
+    grid = Grid(n, n)
+    return ContactProblem(grid, fractal(grid, k_l, k_s, 0.8, 2e-4, seed), 1.0, PETSc.COMM_SELF,
+                          fft_effort="FFTW_ESTIMATE", **options)
+
+
+@pytest.fixture(scope="module")
+def small_problem():
+    """:func:`fractal_problem` with its defaults (64^2, k_l = 4, k_s = 16), shared by the tests of a module."""
+    problem = fractal_problem()
+    yield problem
+    problem.destroy()
+
+
+def error_lines(out):
+    return [line for line in out.stderr.splitlines() if line.startswith("roughpetsc: error")]
+
+
+def assert_one_clear_error(out, *named):
+    """Exit status 2, no traceback, exactly one ``roughpetsc: error`` line naming every string of ``named``."""
+    assert out.returncode == 2, out.stderr
+    assert "Traceback" not in out.stderr
+    errors = error_lines(out)
+    assert len(errors) == 1, out.stderr
+    for text in named:
+        assert str(text) in errors[0], errors[0]
+    return errors[0]

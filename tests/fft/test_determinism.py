@@ -5,6 +5,7 @@ quasi-Newton solver turns that into different iterate sequences. With the wisdom
 second and every later run reuse the first run's plans: iterations and residuals repeat exactly.
 """
 
+import pytest
 import json
 import os
 
@@ -20,6 +21,8 @@ def _steps(tmp_path, name, extra, ranks):
             for s in json.load(open(tmp_path / name))["steps"]]
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_measured_plans_are_remembered_and_runs_repeat(tmp_path, monkeypatch):
     monkeypatch.delenv("ROUGHPETSC_FFT_EFFORT", raising=False)  # this test is about MEASURE itself
     monkeypatch.delenv("ROUGHPETSC_FFT_WISDOM", raising=False)

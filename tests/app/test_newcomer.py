@@ -7,34 +7,18 @@ import hashlib
 import json
 import os
 import stat
-import subprocess
 import sys
 
 import h5py
 import pytest
 
-from conftest import ROOT, run_cli
+from conftest import ROOT, assert_one_clear_error, error_lines, run_cli, run_process
 
 SMALL = ["-surface_N", 64, "-surface_ks", 16, "-surface_kl", 4]
 
 
 def digest(path):
     return hashlib.sha256(open(path, "rb").read()).hexdigest()
-
-
-def error_lines(out):
-    return [line for line in out.stderr.splitlines() if line.startswith("roughpetsc: error")]
-
-
-def assert_one_clear_error(out, *named):
-    """Exit status 2, no traceback, exactly one ``roughpetsc: error`` line naming every string of ``named``."""
-    assert out.returncode == 2, out.stderr
-    assert "Traceback" not in out.stderr
-    errors = error_lines(out)
-    assert len(errors) == 1, out.stderr
-    for text in named:
-        assert str(text) in errors[0], errors[0]
-    return errors[0]
 
 
 @pytest.fixture
@@ -147,9 +131,10 @@ BAD_OUTPUTS = [
 ]
 
 
+@pytest.mark.mpi
 @pytest.mark.parametrize("args, named", BAD_OUTPUTS)
 def test_bad_outputs_on_two_ranks_end_with_one_message(tmp_path, args, named):
-    out = run_cli(args(tmp_path), ranks=2, timeout=120)  # a hang fails here as TimeoutExpired
+    out = run_cli(args(tmp_path), ranks=2)  # a hang fails here as TimeoutExpired
     assert out.returncode != 0
     assert "Traceback" not in out.stderr
     errors = error_lines(out)
@@ -208,9 +193,10 @@ def test_a_missing_options_file_is_named(tmp_path):
     assert "PETSc" not in out.stderr
 
 
+@pytest.mark.mpi
 @pytest.mark.parametrize("size", [32768, 100000])
 def test_a_grid_too_large_for_memory_is_refused_up_front(size):
-    out = run_cli(["-surface_N", size], timeout=60)
+    out = run_cli(["-surface_N", size])
     message = assert_one_clear_error(out, "-surface_N", f"{size}x{size}", "GiB", "available")
     assert out.stdout == ""
     assert message
@@ -248,8 +234,7 @@ def test_help_prints_our_options_and_presets_before_petsc(tmp_path):
 def test_help_into_a_pager_that_stops_early_ends_quietly():
     """`-help | head` closes the pipe while help is still printing: no PETSc crash banner."""
     command = f"{sys.executable} -m roughpetsc -help | head -n 2"
-    out = subprocess.run(["bash", "-c", command], capture_output=True, text=True, cwd=ROOT, timeout=120,
-                         env=dict(os.environ, PYTHONPATH=ROOT))
+    out = run_process(["bash", "-c", command], cwd=ROOT, env=dict(os.environ, PYTHONPATH=ROOT))
     assert out.stdout.startswith("roughpetsc options")
     assert "PETSC ERROR" not in out.stderr and "MPI_ABORT" not in out.stderr, out.stderr
 

@@ -12,8 +12,8 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import MPI_ENV, ROOT, run_cli, run_on_terminal
-from test_newcomer import assert_one_clear_error
+from conftest import MPI_ENV, ROOT, finish, run_cli, run_on_terminal, run_process
+from conftest import assert_one_clear_error
 
 TINY = ["-surface_N", 32, "-surface_ks", 8, "-surface_kl", 2, "-fft_effort", "FFTW_ESTIMATE"]
 
@@ -54,6 +54,7 @@ def test_resume_with_other_load_kind_is_refused(saved_path):
     assert_one_clear_error(out, "-resume", "differs at step 1: pbar 0.001 here, pstar 0.1 in the file")
 
 
+@pytest.mark.mpi
 def test_resume_with_a_longer_list_extends_the_path(saved_path):
     before = saved_steps(saved_path)
     # Its own -json is rewritten without -overwrite.
@@ -105,10 +106,11 @@ def interrupt_after(run, marker, count):
     run.send_signal(signal.SIGINT)
     # Read on through run.stdout: communicate() would read the pipe past what readline() has buffered.
     rest, stderr = run.stdout.read(), run.stderr.read()
-    run.wait(timeout=300)
+    finish(run, run.args)
     return "".join(seen) + rest, stderr
 
 
+@pytest.mark.mpi
 @pytest.mark.parametrize("ranks, fields", [(1, "last"), (2, "all"), (2, "last")])
 def test_an_interrupted_path_holds_every_step_it_printed(tmp_path, ranks, fields):
     """`timeout -s INT 5 mpiexec -n 2 ... -output_fields all` once printed 8 converged steps and kept 4, silently."""
@@ -160,8 +162,7 @@ def test_output_into_a_pipe_closed_early_ends_quietly(tmp_path):
     loads = ",".join(f"{0.05 * k:g}" for k in range(1, 21))
     command = (f"{sys.executable} -m roughpetsc {' '.join(map(str, TINY))} -pstar_list {loads} -json p.json "
                "| head -n 2; exit ${PIPESTATUS[0]}")
-    out = subprocess.run(["bash", "-c", command], capture_output=True, text=True, cwd=tmp_path, timeout=300,
-                         env=dict(os.environ, PYTHONPATH=ROOT))
+    out = run_process(["bash", "-c", command], cwd=tmp_path, env=dict(os.environ, PYTHONPATH=ROOT))
     assert out.returncode == 0, out.stderr
     assert len(out.stdout.splitlines()) == 2
     assert "PETSC ERROR" not in out.stderr and "BrokenPipe" not in out.stderr, out.stderr
@@ -173,6 +174,7 @@ def test_output_into_a_pipe_closed_early_ends_quietly(tmp_path):
 PROGRESS = TINY + ["-pstar_list", "0.2,0.4", "-progress_interval", 1e-9]
 
 
+@pytest.mark.mpi
 def test_progress_on_a_terminal_behind_mpiexec(tmp_path):
     command = ["mpiexec", "-n", "2", "--oversubscribe", sys.executable, "-m", "roughpetsc", *map(str, PROGRESS)]
     status, printed = run_on_terminal(command, tmp_path)
@@ -180,6 +182,7 @@ def test_progress_on_a_terminal_behind_mpiexec(tmp_path):
     assert "... step 2 of 2 (pstar 0.4): inner solve 1, iteration" in printed
 
 
+@pytest.mark.mpi
 def test_no_progress_into_a_log_under_mpiexec(tmp_path):
     """Open MPI gives each rank a terminal: isatty() is true there, yet mpiexec writes into a pipe or a file."""
     out = run_cli(PROGRESS, ranks=2)

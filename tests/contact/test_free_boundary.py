@@ -112,6 +112,7 @@ def test_hertz_errors_converge_with_the_grid():
     assert errors[2] < errors[1] < errors[0]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("tao_type, control", [(None, "displacement"), ("bnls", "load"), ("blmvm", "displacement"),
                                                ("tron", "displacement"), ("almm", "load")])
 def test_every_solver_solves_the_free_boundary(tao_type, control):
@@ -122,6 +123,8 @@ def test_every_solver_solves_the_free_boundary(tao_type, control):
     assert np.abs(pressure - reference_pressure).max() < 1e-6 * reference_pressure.max()
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 @pytest.mark.parametrize("ranks", [2, 3])
 def test_free_boundary_on_several_ranks_equals_one_rank(tmp_path, ranks):
     args = ["-surface_N", 40, "-surface_N0", 38, "-surface_ks", 10, "-surface_kl", 2, "-boundary", "free",
@@ -129,7 +132,7 @@ def test_free_boundary_on_several_ranks_equals_one_rank(tmp_path, ranks):
     fields = []
     for count in (1, ranks):
         path = tmp_path / f"free{count}.h5"
-        out = run_cli(args + ["-output", path], ranks=count, timeout=120)
+        out = run_cli(args + ["-output", path], ranks=count)
         assert out.returncode == 0, out.stdout + out.stderr
         with h5py.File(path) as f:
             fields.append(f["pressure"][()])

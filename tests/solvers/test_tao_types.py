@@ -4,21 +4,16 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from roughpetsc.contact.problem import ContactProblem
 from roughpetsc.solvers.facade import Solver
-from roughpetsc.surface.grid import Grid
-from roughpetsc.surface.generators import fractal
 
-from conftest import applications_at_time_limit
+from conftest import applications_at_time_limit, fractal_problem
 
 TYPES = ["blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bnls", "bntr", "tron", "gpcg"]
 
 
 def _pk_reference(n, k_l, k_s):
     """Load control by Polonsky-Keer at p* = 0.5 on an n^2 fractal surface, solved to 1e-12."""
-    grid = Grid(n, n)
-    problem = ContactProblem(grid, fractal(grid, k_l, k_s, 0.8, 2e-4, 7), 1.0, PETSc.COMM_SELF,
-                             fft_effort="FFTW_ESTIMATE")
+    problem = fractal_problem(n, k_l, k_s, seed=7)
     solver = Solver(problem, "load", None, 1e-12)
     result = solver.solve(pstar=0.5)
     pressure = solver.fields()[0].copy()
@@ -58,6 +53,7 @@ def small_reference():
     problem.destroy()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("tao_type, size", [("bqnls", 128), ("almm", 64)])
 def test_other_load_controls_agree_with_pk(reference, small_reference, tao_type, size):
     problem, load_result, pressure = reference if size == 128 else small_reference
@@ -77,9 +73,7 @@ def test_newton_types_under_load_control_near_complete_contact(tao_type):
     """The root find's first separations make every node free, where K is singular (K 1 = 0): the Fourier
     preconditioner must stay positive definite there (it broke BNLS/BNTR's Krylov solves: time limit
     at a natural residual of 0.78 on 128^2, p* = 3)."""
-    grid = Grid(128, 128)
-    problem = ContactProblem(grid, fractal(grid, 16, 64, 0.8, 2e-4, 3), 1.0, PETSc.COMM_SELF,
-                             fft_effort="FFTW_ESTIMATE")
+    problem = fractal_problem(128, 16, 64, seed=3)
     PETSc.Options().setValue("solve_max_time", 60)
     PETSc.Options().setValue("bound_pc", "fourier")
     solver = Solver(problem, "load", tao_type, 1e-10)
@@ -101,9 +95,7 @@ def test_root_find_meets_the_load_near_complete_contact(tao_type):
     """Near complete contact the mean pressure is so steep in d that Brent's bracket reaches round-off
     first (load error 4e-8 with tron before); the solution is affine in d on a fixed contact set, so the
     interpolation between the bracket's solutions meets the load, certified on a fresh gap."""
-    grid = Grid(64, 64)
-    problem = ContactProblem(grid, fractal(grid, 4, 16, 0.8, 2e-4, 5), 1.0, PETSc.COMM_SELF,
-                             fft_effort="FFTW_ESTIMATE")
+    problem = fractal_problem(64, 4, 16, seed=5)
     pstar = 0.98 * problem.complete_contact_pbar * problem.pressure_scale / problem.sqrt_m0p
     solver = Solver(problem, "load", tao_type, 1e-10)
     try:
@@ -119,9 +111,7 @@ def test_root_find_meets_the_load_near_complete_contact(tao_type):
 def test_almm_stops_within_a_line_search_of_its_time_limit(monkeypatch):
     """ALMM's time limit ends its subsolve (a zero gradient did not: the augmented Lagrangian keeps the
     constraint term, and a 1024^2 solve ran 994 operator applications, 100 s, past a 10 s limit)."""
-    grid = Grid(256, 256)
-    problem = ContactProblem(grid, fractal(grid, 16, 64, 0.8, 2e-4, 5), 1.0, PETSc.COMM_SELF,
-                             fft_effort="FFTW_ESTIMATE")
+    problem = fractal_problem(256, 16, 64, seed=5)
     at_limit = applications_at_time_limit(monkeypatch, problem)
     PETSc.Options().setValue("solve_max_time", 0.5)
     solver = Solver(problem, "load", "almm", 1e-12)

@@ -10,7 +10,6 @@ import contextlib
 import json
 import math
 import os
-import subprocess
 import sys
 
 import numpy as np
@@ -18,7 +17,7 @@ import pytest
 
 import h5py
 
-from conftest import MPI_ENV, ROOT, applications_at_time_limit, run_cli
+from conftest import MPI_ENV, ROOT, applications_at_time_limit, run_cli, run_process
 from roughpetsc.contact import AdhesiveProblem, approach_retraction, dissipated_energy
 from roughpetsc.solvers import Solver, drive
 from roughpetsc.contact.problem import ContactProblem
@@ -170,6 +169,8 @@ problem.destroy()
 """
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_two_and_three_ranks_equal_one_rank(tmp_path):
     script = tmp_path / "ranks.py"
     script.write_text(RANKS_SCRIPT)
@@ -181,7 +182,7 @@ def test_two_and_three_ranks_equal_one_rank(tmp_path):
         command = [sys.executable, str(script), str(out)]
         if ranks > 1:
             command = ["mpiexec", "-n", str(ranks), "--oversubscribe", *command]
-        run = subprocess.run(command, capture_output=True, text=True, env=env, timeout=300)
+        run = run_process(command, env=env)
         assert run.returncode == 0, run.stdout + run.stderr
         answers.append(np.load(out))
     for other in answers[1:]:
@@ -191,6 +192,7 @@ def test_two_and_three_ranks_equal_one_rank(tmp_path):
         assert np.abs(other["pressure"] - answers[0]["pressure"]).max() < 1e-9 * scale
 
 
+@pytest.mark.mpi
 def test_command_line_cycle_on_two_ranks_equals_one_rank(tmp_path):
     """-adhesion with -gbar_list: approach and retraction, the HDF5 record, 2 ranks equal to 1.
 
@@ -203,7 +205,7 @@ def test_command_line_cycle_on_two_ranks_equals_one_rank(tmp_path):
     runs = []
     for ranks in (1, 2):
         path = tmp_path / f"cycle{ranks}.h5"
-        out = run_cli(args + ["-output", path], ranks=ranks, timeout=120)
+        out = run_cli(args + ["-output", path], ranks=ranks)
         assert out.returncode == 0, out.stdout + out.stderr
         assert "Tabor parameter" in out.stdout
         with h5py.File(path) as f:
@@ -222,7 +224,7 @@ def test_command_line_cycle_reports_its_dissipated_energy(tmp_path):
     path = tmp_path / "cycle.h5"
     out = run_cli(["-surface_N", 48, "-surface_ks", 12, "-surface_kl", 2, "-adhesion", "exponential",
                    "-adhesion_work", 2e-7, "-adhesion_range", 2e-5, "-gbar_list", "2e-4,1e-4,5e-5,1e-4,2e-4",
-                   "-fft_effort", "FFTW_ESTIMATE", "-output", path], timeout=120)
+                   "-fft_effort", "FFTW_ESTIMATE", "-output", path])
     assert out.returncode == 0, out.stdout + out.stderr
     assert "energy dissipated per unit area" in out.stdout
     with h5py.File(path) as f:
@@ -372,6 +374,7 @@ def test_penny_shaped_adhesive_crack_meets_the_maugis_dugdale_crack():
     assert min(p for p, _, _ in states) > sigma  # every crack is open above E (6.38)
 
 
+@pytest.mark.slow
 def test_dugdale_wave_tends_to_johnsons_jkr_wave():
     """Johnson's wave at alpha = 0.3 with a short Dugdale range (h0 = 0.03 h, Maugis's lambda 6.4 at the crest):
     the JKR limit. The contact half-width against the load follows Johnson's pbar = p* (sin^2 psi - alpha
@@ -395,6 +398,7 @@ def test_dugdale_wave_tends_to_johnsons_jkr_wave():
     assert abs(snap_off - jkr_pulloff_displacement_control(1.0, amplitude, 1.0, work)[2]) < 0.02 * amplitude + step
 
 
+@pytest.mark.slow
 def test_tao_almm_stops_within_a_line_search_of_its_time_limit(monkeypatch):
     """The time limit ends ALMM's subsolve (a zero gradient left the augmented Lagrangian's constraint term)."""
     grid = Grid(256, 256, 1.0, 1.0)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from conftest import run_cli
-from test_newcomer import assert_one_clear_error
+from conftest import assert_one_clear_error
 
 TINY = ["-surface_N", 32, "-surface_ks", 8, "-surface_kl", 2, "-fft_effort", "FFTW_ESTIMATE"]
 CYCLE = ["-gbar_list", "1e-3,6e-4,3e-4,1.5e-4,3e-4,6e-4,1e-3"]

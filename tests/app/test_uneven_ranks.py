@@ -27,7 +27,7 @@ def solve(tmp_path, ranks, extra=()):
     """Run the solve mode; returns (fields from the HDF5 file, the JSON steps)."""
     name = f"r{ranks}_{'_'.join(str(a).strip('-') for a in extra)}"
     h5, js = tmp_path / f"{name}.h5", tmp_path / f"{name}.json"
-    out = run_cli(UNEVEN + list(extra) + ["-output", h5, "-json", js], ranks=ranks, timeout=120)
+    out = run_cli(UNEVEN + list(extra) + ["-output", h5, "-json", js], ranks=ranks)
     assert out.returncode == 0, out.stdout + out.stderr
     with h5py.File(h5) as f:
         fields = {k: f[k][()] for k in ("heights", "pressure", "gap")}
@@ -57,6 +57,8 @@ def one_rank(tmp_path_factory):
     return {effort: solve(folder, 1, ["-fft_effort", effort]) for effort in ("FFTW_ESTIMATE", "FFTW_MEASURE")}
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 @pytest.mark.parametrize("effort", ["FFTW_ESTIMATE", "FFTW_MEASURE"])
 @pytest.mark.parametrize("ranks", [3, 4])
 def test_uneven_rows_equal_one_rank(tmp_path, one_rank, ranks, effort):
@@ -71,19 +73,23 @@ def test_planner_efforts_agree(one_rank):
     assert max(measured.values()) <= TOLERANCE, measured
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_displacement_control_on_three_ranks(tmp_path):
     """Displacement control (the mean-mode term of the preconditioner, global sums over uneven blocks)."""
     common = ["-surface_N", 66, "-surface_N0", 62, "-surface_ks", 16, "-surface_kl", 4, "-kkt_rtol", 1e-13,
               "-gbar", 3e-4, "-fft_effort", "FFTW_ESTIMATE"]
     steps = {}
     for ranks in (1, 3):
-        out = run_cli(common + ["-json", tmp_path / f"d{ranks}.json"], ranks=ranks, timeout=120)
+        out = run_cli(common + ["-json", tmp_path / f"d{ranks}.json"], ranks=ranks)
         assert out.returncode == 0, out.stdout + out.stderr
         steps[ranks] = json.load(open(tmp_path / f"d{ranks}.json"))["steps"][0]
     for key in ("A", "pbar", "gbar"):
         assert steps[3][key] == pytest.approx(steps[1][key], rel=TOLERANCE), key
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_tao_bound_solver_on_four_ranks(tmp_path):
     """A TAO bound solver with the Fourier preconditioner on the free set (createSubMatrix on uneven blocks).
 
@@ -93,7 +99,7 @@ def test_tao_bound_solver_on_four_ranks(tmp_path):
               "-pstar", 0.5, "-tao_type", "bntr", "-bound_pc", "fourier", "-fft_effort", "FFTW_ESTIMATE"]
     steps = {}
     for ranks in (1, 4):
-        out = run_cli(common + ["-json", tmp_path / f"t{ranks}.json"], ranks=ranks, timeout=120)
+        out = run_cli(common + ["-json", tmp_path / f"t{ranks}.json"], ranks=ranks)
         assert out.returncode == 0, out.stdout + out.stderr
         steps[ranks] = json.load(open(tmp_path / f"t{ranks}.json"))["steps"][0]
     assert steps[4]["converged"]
@@ -101,13 +107,16 @@ def test_tao_bound_solver_on_four_ranks(tmp_path):
     assert steps[4]["gbar"] == pytest.approx(steps[1]["gbar"], rel=1e-6)
 
 
+@pytest.mark.mpi
 def test_more_ranks_than_rows_is_refused_by_name(tmp_path):
-    out = run_cli(["-surface_N", 16, "-surface_N0", 3, "-surface_ks", 4, "-surface_kl", 2], ranks=4, timeout=120)
+    out = run_cli(["-surface_N", 16, "-surface_N0", 3, "-surface_ks", 4, "-surface_kl", 2], ranks=4)
     assert out.returncode == 2, out.stdout + out.stderr
     errors = [line for line in out.stderr.splitlines() if line.startswith("roughpetsc: error")]
     assert len(errors) == 1 and "-surface_N0/-surface_N" in errors[0], out.stderr
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_ensemble_group_of_three_ranks_equals_one_rank(tmp_path):
     """An ensemble group solves each surface on its own communicator: uneven rows there too."""
     common = ["-mode", "ensemble", "-surface_N", 62, "-surface_ks", 16, "-surface_kl", 4, "-ensemble_size", 2,
@@ -116,7 +125,7 @@ def test_ensemble_group_of_three_ranks_equals_one_rank(tmp_path):
     steps = {}
     for ranks, extra in ((1, []), (3, ["-ensemble_group_ranks", 3])):
         path = tmp_path / f"e{ranks}.h5"
-        out = run_cli(common + extra + ["-output", path], ranks=ranks, timeout=120)
+        out = run_cli(common + extra + ["-output", path], ranks=ranks)
         assert out.returncode == 0, out.stdout + out.stderr
         with h5py.File(path) as f:
             steps[ranks] = {key: f[f"steps/{key}"][()] for key in ("A", "A_corrected", "gbar")}

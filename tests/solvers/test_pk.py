@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
+from conftest import fractal_problem
 from roughpetsc.contact.problem import ContactProblem
 from roughpetsc.solvers.facade import Solver
 from roughpetsc.surface.grid import Grid
@@ -16,9 +17,7 @@ from roughpetsc.surface.generators import fractal
 
 @pytest.fixture(scope="module")
 def problem():
-    grid = Grid(128, 128)
-    problem = ContactProblem(grid, fractal(grid, 16, 64, 0.8, 2e-4, 3), 1.0, PETSc.COMM_SELF,
-                             fft_effort="FFTW_ESTIMATE")
+    problem = fractal_problem(128, 16, 64)
     yield problem
     problem.destroy()
 

@@ -53,6 +53,7 @@ def dense_reference(grid, heights, problem, separation):
     return found.x.reshape(grid.shape)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("tao_type, control", [(None, "displacement"), ("blmvm", "displacement"),
                                                ("tron", "displacement"), ("bnls", "displacement"),
                                                (None, "load"), ("bnls", "load"), ("almm", "load")])
@@ -114,13 +115,15 @@ def test_a_cap_never_reached_changes_nothing():
     assert np.abs(p_cap - p_free).max() < 1e-9 * p_free.max()
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_hardness_on_two_ranks_equals_one_rank(tmp_path):
     args = ["-surface_N", 40, "-surface_ks", 10, "-surface_kl", 2, "-hardness", 0.012, "-kkt_rtol", 1e-13,
             "-pstar_list", "0.3,1", "-fft_effort", "FFTW_ESTIMATE"]
     fields, plastic = [], []
     for ranks in (1, 2):
         path = tmp_path / f"cap{ranks}.h5"
-        out = run_cli(args + ["-output", path], ranks=ranks, timeout=120)
+        out = run_cli(args + ["-output", path], ranks=ranks)
         assert out.returncode == 0, out.stdout + out.stderr
         with h5py.File(path) as f:
             fields.append(f["pressure"][()])

@@ -147,6 +147,8 @@ def test_hertz_stresses_on_the_axis():
     assert surface.components["xx"][centre, centre + nodes] == pytest.approx((1 - 2 * nu) / 3, abs=5e-3)
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 @pytest.mark.parametrize("boundary", ["periodic", "free"])
 def test_command_line_writes_the_stresses_of_the_last_step(tmp_path, boundary):
     import h5py

@@ -3,22 +3,15 @@
 import pytest
 from petsc4py import PETSc
 
-from roughpetsc.contact.problem import ContactProblem
 from roughpetsc.errors import ParameterError
 from roughpetsc.solvers import Solver, backend_names, load_path, make_backend, register, unregister
-from roughpetsc.surface.grid import Grid
-from roughpetsc.surface.generators import fractal
 
 LOADS = [0.05, 0.2, 0.5, 1.0]
 
 
 @pytest.fixture(scope="module")
-def problem():
-    grid = Grid(64, 64)
-    problem = ContactProblem(grid, fractal(grid, 4, 16, 0.8, 2e-4, 3), 1.0, PETSc.COMM_SELF,
-                             fft_effort="FFTW_ESTIMATE")
-    yield problem
-    problem.destroy()
+def problem(small_problem):
+    return small_problem
 
 
 class Recorder:

@@ -6,7 +6,6 @@ counts that they do not divide.
 """
 
 import os
-import subprocess
 import sys
 
 import numpy as np
@@ -17,7 +16,7 @@ from roughpetsc.fft.slab import SlabTransform
 from roughpetsc.parallel import block_split, row_split
 from roughpetsc.surface.grid import Grid
 
-from conftest import MPI_ENV, ROOT
+from conftest import MPI_ENV, ROOT, run_process
 
 # Run under mpiexec: every rank checks its part against numpy on the whole array.
 DRIVER = r"""
@@ -110,9 +109,11 @@ def run_driver(ranks, tmp_path):
     env = dict(os.environ, **MPI_ENV)
     env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
     command = ["mpiexec", "-n", str(ranks), "--oversubscribe", sys.executable, str(driver)]
-    return subprocess.run(command, capture_output=True, text=True, env=env, timeout=300, cwd=ROOT)
+    return run_process(command, env=env, cwd=ROOT)
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 @pytest.mark.parametrize("ranks", [1, 2, 3, 4])
 def test_slab_pair_matches_numpy(ranks, tmp_path):
     done = run_driver(ranks, tmp_path)
@@ -129,6 +130,7 @@ def test_block_split_is_balanced():
     assert list(counts) == [21, 21, 20] and list(starts) == [0, 21, 42]
 
 
+@pytest.mark.mpi
 def test_fewer_rows_than_ranks_is_refused_by_name():
     with pytest.raises(ParameterError, match="fewer than the 4 MPI ranks") as refused:
         row_split(3, 4)

@@ -11,7 +11,7 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import MPI_ENV, ROOT, run_cli, run_on_terminal
+from conftest import MPI_ENV, ROOT, finish, run_cli, run_on_terminal
 
 SMALL = ["-surface_N", 64, "-surface_ks", 16, "-surface_kl", 4]
 PATH = ["-pstar_list", "0.2,0.5,1"]
@@ -75,6 +75,8 @@ def test_datasets_carry_units_and_the_surface_parameters_are_recorded(tmp_path):
                           "surface_seed": 1, "surface_generator": "filter"}
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_a_path_out_of_time_keeps_its_steps_and_resumes(tmp_path):
     args = SMALL + PATH + ["-kkt_rtol", 1e-11, "-output_fields", "all"]
     out = run_cli(args + ["-output", tmp_path / "r.h5", "-solve_max_time", 1e-9])
@@ -91,6 +93,7 @@ def test_a_path_out_of_time_keeps_its_steps_and_resumes(tmp_path):
     assert out.returncode == 2 and "another problem (different surface)" in out.stderr
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_the_finished_steps_and_resume_completes_the_path(tmp_path):
     loads = ",".join(f"{0.05 * i:.2f}" for i in range(1, 41))
     args = ["-surface_N", 128, "-pk_pc", "none", "-kkt_rtol", 1e-11, "-pstar_list", loads, "-output_fields", "all"]
@@ -104,7 +107,7 @@ def test_ctrl_c_keeps_the_finished_steps_and_resume_completes_the_path(tmp_path)
     while not output.exists() and run.poll() is None:  # the first step is saved
         time.sleep(0.01)
     run.send_signal(signal.SIGINT)
-    _, stderr = run.communicate(timeout=120)
+    _, stderr = finish(run, command)
     assert run.returncode == 130, stderr
     assert "Traceback" not in stderr and "rerun with -resume" in stderr
     finished = steps_of(output)
@@ -140,6 +143,8 @@ def test_progress_lines_on_a_terminal_only(tmp_path):
     assert out.returncode == 0 and "... step" not in out.stdout
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_fields_written_by_every_rank_equal_one_rank(tmp_path):
     """Under mpiexec Debian's h5py is the parallel build: each rank writes its rows of the fields (store)."""
     import h5py

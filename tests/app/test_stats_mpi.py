@@ -2,18 +2,15 @@
 
 import json
 import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
-from conftest import run_cli
+from conftest import ROOT, run_cli, run_process
 from roughpetsc import ensemble
 from roughpetsc.surface import seeds
 from roughpetsc.store import stats_file
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PYTHON = "/usr/bin/python3"
 
 DRIVER = """
@@ -40,7 +37,7 @@ def run_stats(ranks, arguments, tmp_path):
     driver = tmp_path / "driver.py"
     driver.write_text(DRIVER)
     command = ["mpiexec", "-n", str(ranks), "--oversubscribe", PYTHON, str(driver)] + arguments
-    return subprocess.run(command, capture_output=True, text=True, env=environment, timeout=120, cwd=ROOT)
+    return run_process(command, env=environment, cwd=ROOT)
 
 
 def stats_json(ranks, arguments, tmp_path):
@@ -50,6 +47,7 @@ def stats_json(ranks, arguments, tmp_path):
     return json.loads(path.read_text()), result.stdout
 
 
+@pytest.mark.mpi
 def test_ensemble_on_two_ranks_equals_one_rank(tmp_path):
     arguments = ENSEMBLE + ["-stats_ensemble", "5"]
     one, _ = stats_json(1, arguments, tmp_path)
@@ -130,6 +128,8 @@ def test_bad_input_names_the_option_on_two_ranks(tmp_path, arguments, option):
     assert not list(tmp_path.glob("*.json"))
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_one_master_seed_means_one_surface_in_stats_and_ensemble_modes(tmp_path):
     """(master seed, index) -> one surface: -mode stats and -mode ensemble, on 1 and 2 ranks."""
     surface = ["-surface_N", "64", "-surface_kl", "4", "-surface_ks", "16", "-ensemble_seed", "7"]
@@ -179,6 +179,7 @@ except UserError as error:
 """
 
 
+@pytest.mark.mpi
 def test_a_library_error_on_one_rank_stops_every_rank(tmp_path):
     """A ParameterError raised on rank 1 alone is every rank's UserError naming the option (no rank hangs)."""
     driver = tmp_path / "one_rank_fails.py"
@@ -188,7 +189,7 @@ def test_a_library_error_on_one_rank_stops_every_rank(tmp_path):
                        ONE_RANK_FAILS_OUT=str(tmp_path / "error"))
     command = ["mpiexec", "-n", "2", "--oversubscribe", PYTHON, str(driver), "-surface_N", "32",
                "-surface_kl", "2", "-surface_ks", "8", "-ensemble_seed", "3", "-stats_ensemble", "2"]
-    result = subprocess.run(command, capture_output=True, text=True, env=environment, timeout=60, cwd=ROOT)
+    result = run_process(command, env=environment, cwd=ROOT)
     assert result.returncode == 2, result.stderr
     for rank in (0, 1):  # the message of rank 1's error, raised on both ranks
         message = (tmp_path / f"error.rank{rank}").read_text()

@@ -12,6 +12,7 @@ import roughpetsc.models as M
 from roughpetsc.models import pdfs
 
 import dissertation_formulas as reference_formulas
+from conftest import ROOT
 
 
 def test_ciavarella_against_5_52_and_5_53():
@@ -166,8 +167,7 @@ def test_fit_recovers_a_5_37_curve_made_by_quadrature():
     assert abs(bf - b) < 1e-6 and abs(df - d) < 1e-6 and abs(cf - c) < 1e-6
 
 
-ENSEMBLES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "studies", "output",
-                         "ensembles")
+ENSEMBLES = os.path.join(ROOT, "studies", "output", "ensembles")
 
 
 @pytest.mark.parametrize("group, grid", [(18, 1024), (27, 2048)])

@@ -28,6 +28,7 @@ def test_default_run_prints_a_converged_solution(tmp_path):
     assert summary["surface"]["m0p"] == pytest.approx(summary["surface"]["m2h"] / 2, rel=1e-12)
 
 
+@pytest.mark.mpi
 def test_two_ranks_equal_one_rank(tmp_path):
     results = {}
     for ranks in (1, 2):
@@ -126,6 +127,8 @@ def test_bad_input_gives_one_clear_message(tmp_path, args, ranks, named):
     assert not [p for p in os.listdir(tmp_path) if p.startswith(".tmp-")]
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_headline_usage_bqnls_on_two_ranks(tmp_path):
     """`mpiexec -n 2 python -m roughpetsc -tao_type bqnls`: load control by the root find around BQNLS."""
     out = run_cli(SMALL + ["-tao_type", "bqnls", "-json", tmp_path / "b.json"], ranks=2)
@@ -157,13 +160,14 @@ def test_non_convergence_is_reported_with_petsc_reason(tmp_path):
 # The second case: the root find's first inner solve ends at its start, whose mean pressure is the load itself;
 # the time limit is still the reason (it read DIVERGED_ROOT_INNER, "the load is met", when the loaded machine
 # let the limit fall there on two ranks).
+@pytest.mark.mpi
 @pytest.mark.parametrize("ranks, args", [(1, SMALL + ["-pk_pc", "none", "-solve_max_time", 1e-9]),
                                          (1, SMALL + ["-tao_type", "bqnls", "-solve_max_time", 1e-9]),
                                          (2, ["-surface_N", 256, "-surface_ks", 64, "-surface_kl", 4, "-tao_type",
                                               "bqnls", "-kkt_rtol", 1e-13, "-solve_max_time", 0.3])])
 def test_time_limit_is_reported_as_not_converged(tmp_path, ranks, args):
     """On two ranks the limit lands mid-solve: rank 0's clock decides for both (no hang, one verdict)."""
-    out = run_cli(args + ["-json", tmp_path / "t.json"], ranks=ranks, timeout=120)
+    out = run_cli(args + ["-json", tmp_path / "t.json"], ranks=ranks)
     assert out.returncode == 3, out.stderr
     step = json.load(open(tmp_path / "t.json"))["steps"][0]
     assert not step["converged"] and step["reason"].startswith("DIVERGED_USER")

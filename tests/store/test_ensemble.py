@@ -12,7 +12,7 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import MPI_ENV, ROOT, run_cli
+from conftest import MPI_ENV, ROOT, SUBPROCESS_TIMEOUT, run_cli
 from roughpetsc import ensemble
 from roughpetsc.contact import loads
 from roughpetsc.errors import UserError
@@ -72,6 +72,8 @@ def test_seeds_derive_from_the_master_seed():
 # (b) the file; the same numbers on 1 and 2 ranks
 # ----------------------------------------------------------------------------
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_file_layout_and_same_numbers_on_one_and_two_ranks(tmp_path, monkeypatch):
     args = SMALL + ["-ensemble_size", 3, "-ensemble_loads", FEW_LOADS, "-kkt_rtol", 1e-12]
     runs = {"r1": ([], 1), "r2": ([], 2), "g2": (["-ensemble_group_ranks", 2], 2)}
@@ -175,6 +177,8 @@ def _solved(stdout):
     return [int(i) for i in re.findall(r"^surface\s+(\d+) seed", stdout, re.M)]
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_kill_and_resume_gives_the_same_file(tmp_path):
     size = 6
     args = ["-mode", "ensemble", "-surface_N", 128, "-surface_kl", 8, "-surface_ks", 32, "-ensemble_size", size,
@@ -187,7 +191,7 @@ def test_kill_and_resume_gives_the_same_file(tmp_path):
     process = subprocess.Popen(command, cwd=ROOT, env=env, start_new_session=True, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)
     try:
-        deadline = time.time() + 300
+        deadline = time.time() + SUBPROCESS_TIMEOUT
         while process.poll() is None and time.time() < deadline and _finished(killed) < 1:
             time.sleep(0.02)
         assert process.poll() is None, "the run ended before it could be killed"

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import run_cli
-from test_newcomer import assert_one_clear_error
+from conftest import assert_one_clear_error
 
 TINY = ["-surface_N", 32, "-surface_ks", 8, "-surface_kl", 2, "-fft_effort", "FFTW_ESTIMATE"]
 
@@ -63,6 +63,7 @@ def long_list(count):
     return [0.05 + 0.0012345678901 * i for i in range(count)]
 
 
+@pytest.mark.mpi
 @pytest.mark.parametrize("ranks", [1, 2])
 def test_a_long_load_list_is_read_whole(tmp_path, ranks):
     loads = long_list(150)

@@ -10,7 +10,7 @@ import pytest
 from conftest import run_cli
 from roughpetsc import ContactProblem, Grid, ParameterError, Westergaard, fractal, fractal_amplitude, load_surface
 from roughpetsc.surface import files, generators, spectra
-from test_newcomer import assert_one_clear_error
+from conftest import assert_one_clear_error
 
 GRID = Grid(32, 32)
 SOLVE = ["-pstar", 0.5, "-fft_effort", "FFTW_ESTIMATE"]
@@ -170,6 +170,7 @@ def test_psd_on_the_command_line(tmp_path):
     assert document["psd"]["hurst"] == pytest.approx(0.7, abs=1e-10)
 
 
+@pytest.mark.mpi
 def test_psd_of_an_ensemble_on_two_ranks_equals_one(tmp_path):
     args = ["-mode", "stats", "-surface_N", 32, "-surface_kl", 2, "-surface_ks", 8, "-stats_ensemble", 3]
     outs = []

@@ -13,7 +13,7 @@ import time
 import h5py
 import pytest
 
-from conftest import MPI_ENV, ROOT, run_cli
+from conftest import MPI_ENV, ROOT, SUBPROCESS_TIMEOUT, finish, run_cli
 from roughpetsc import ensemble
 
 ARGS = ["-mode", "ensemble", "-surface_N", 64, "-surface_kl", 4, "-surface_ks", 16, "-ensemble_models", "none",
@@ -54,17 +54,19 @@ def _digest(path):
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_disk_full_during_an_ensemble_stops_with_one_message_and_keeps_the_file(small_disk):
     output = small_disk / "run.h5"
     command = ["mpiexec", "-n", "2", "--oversubscribe", sys.executable, "-m", "roughpetsc",
                *[str(a) for a in ARGS + ["-ensemble_size", 40, "-output", output]]]
     env = dict(os.environ, **MPI_ENV, PYTHONPATH=ROOT)
     process = subprocess.Popen(command, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    deadline = time.time() + 120
+    deadline = time.time() + SUBPROCESS_TIMEOUT
     while process.poll() is None and _finished(output) < 1 and time.time() < deadline:
         time.sleep(0.01)
     _fill(small_disk)
-    stdout, stderr = process.communicate(timeout=120)
+    stdout, stderr = finish(process, command)
     assert process.returncode != 0
     assert "roughpetsc: error: cannot write" in stderr and "No space left on device" in stderr, stderr
     assert "Traceback" not in stderr and len([line for line in stderr.splitlines() if "roughpetsc" in line]) == 1
@@ -78,6 +80,8 @@ def test_disk_full_during_an_ensemble_stops_with_one_message_and_keeps_the_file(
         assert ensemble.read(output)["@n_finished"] == 6
 
 
+@pytest.mark.mpi
+@pytest.mark.slow
 def test_read_only_folder_refuses_before_work_and_leaves_the_file(small_disk):
     output = small_disk / "run.h5"
     first = run_cli(ARGS + ["-ensemble_size", 2, "-output", output], ranks=2)
@@ -85,7 +89,7 @@ def test_read_only_folder_refuses_before_work_and_leaves_the_file(small_disk):
     before = _digest(output)
     subprocess.run(["mount", "-o", "remount,ro", str(small_disk)], check=True)
     for extra, ranks in (([], 2), (["-ensemble_size", 4], 2), (["-ensemble_size", 4], 1)):
-        out = run_cli(ARGS + ["-ensemble_size", 2, "-output", output] + extra, ranks=ranks, timeout=120)
+        out = run_cli(ARGS + ["-ensemble_size", 2, "-output", output] + extra, ranks=ranks)
         if extra:
             assert out.returncode == 2, out.stderr
             assert str(output) in out.stderr and "Traceback" not in out.stderr

@@ -4,12 +4,11 @@ unused, -tao_view shows PK's settings, -log_view names every stage, and the READ
 import json
 import os
 import re
-import subprocess
 
 import pytest
 
-from conftest import ROOT, run_cli
-from test_newcomer import assert_one_clear_error
+from conftest import ROOT, run_cli, run_process
+from conftest import assert_one_clear_error
 
 TINY = ["-surface_N", 32, "-surface_ks", 8, "-surface_kl", 2, "-fft_effort", "FFTW_ESTIMATE"]
 
@@ -76,7 +75,6 @@ def test_readme_usage_lines_run_twice_from_a_scratch_folder(tmp_path, index):
                OMPI_MCA_rmaps_base_oversubscribe="1")
     for attempt in (1, 2):
         for command in commands:
-            out = subprocess.run(["bash", "-c", command], capture_output=True, text=True, cwd=tmp_path, env=env,
-                                 timeout=600)
+            out = run_process(["bash", "-c", command], cwd=tmp_path, env=env)
             assert out.returncode == 0, (attempt, command, out.stderr)
     assert not [name for name in os.listdir(ROOT) if name.endswith((".h5", ".json"))]
