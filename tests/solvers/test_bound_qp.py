@@ -4,7 +4,6 @@ Hessian, fused callbacks) against Polonsky-Keer, a second algorithm, and their f
 import json
 import math
 import os
-import subprocess
 import sys
 
 import numpy as np
@@ -16,7 +15,7 @@ from roughpetsc.contact.certificate import report
 from roughpetsc.solvers import Solver, bound_qp
 from roughpetsc.solvers.preconditioner import FourierPreconditioner
 
-from conftest import MPI_ENV, ROOT
+from conftest import MPI_ENV, ROOT, run_process
 from test_tao_types import _pk_reference
 
 TWO_RANKS = """
@@ -132,7 +131,7 @@ def test_two_ranks_equal_one():
         command = [sys.executable, "-c", TWO_RANKS]
         if ranks > 1:
             command = ["mpiexec", "-n", "2", "--oversubscribe", *command]
-        done = subprocess.run(command, capture_output=True, text=True, env=env, timeout=600, cwd=ROOT)
+        done = run_process(command, env=env, cwd=ROOT)
         assert done.returncode == 0, done.stderr[-2000:]
         results.append(json.loads(done.stdout.strip().splitlines()[-1]))
     for name, (converged, pstar, area, separation) in results[0].items():
