@@ -9,9 +9,10 @@ class Progress:
     """Prints where a running load step is, at most every ``interval`` seconds of wall time.
 
     A line names the load step (:meth:`start_step`), the inner solve of the step (a root find on the
-    separation solves several problems in a row, each counting its iterations from 0, and a solve
-    that is resumed to confirm its result is a second one), the iteration, the natural residual and
-    the seconds since the step began::
+    separation solves several problems in a row, each counting its iterations from 0; the augmented
+    Lagrangian of a TAO bound type under load control records each multiplier update at the iteration
+    it stopped, and counts on; a solve that is resumed to confirm its result is a second one), the
+    iteration, the natural residual and the seconds since the step began::
 
           ... step 3 of 95 (pstar 0.02): inner solve 2, iteration 120, KKT natural 1.20e-05, 4.1 s
 
@@ -25,16 +26,20 @@ class Progress:
         self.step = "the solve"
         self.step_started = time.perf_counter()
         self.inner = 0
+        self.last_iteration = -1
 
     def start_step(self, index, count, kind, value):
         """A new load step: the ``index``-th (from 0) of ``count``, ``kind`` (pstar, pbar, gbar) = ``value``."""
         self.step = f"step {index + 1} of {count} ({kind} {value:g})"
         self.step_started = time.perf_counter()
         self.inner = 0
+        self.last_iteration = -1
 
     def __call__(self, iteration, natural, seconds):
-        if iteration == 0:  # every solve records its iteration 0 first
+        # Every inner solve records its first iteration again: 0, or where the previous one stopped.
+        if iteration <= self.last_iteration or iteration == 0:
             self.inner += 1
+        self.last_iteration = iteration
         now = time.perf_counter()
         elapsed = now - self.step_started
         if elapsed >= self.interval and now - self.printed_at >= self.interval:

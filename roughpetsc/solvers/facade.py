@@ -44,7 +44,7 @@ class Solver:
     Attributes
     ----------
     name : str
-        The solver's name in results: the TAO type, ``rootfind(<type>)``, ``almm``, ``pk(<pc>)``, ``gapcg``.
+        The solver's name in results: the TAO type, ``<type>(al)`` (load control), ``rootfind(<type>)`` (``-bound_load rootfind``), ``almm``, ``pk(<pc>)``, ``gapcg``.
     backend :
         The backend object (:mod:`roughpetsc.solvers.protocol`).
     """

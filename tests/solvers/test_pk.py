@@ -146,7 +146,7 @@ def test_load_path_reuses_the_predicted_displacement_and_certifies_every_step(pr
                 pressure, previous = path.pressure, path.previous
                 path.pressure = pressure.copy()
                 path.previous = previous.copy() if previous is not None else None
-                predicted = path.start(target)
+                predicted = path.load_start(target)
                 assert predicted is not None
                 fresh = problem.vec()
                 problem.operator.displacement(path.pressure, fresh)
