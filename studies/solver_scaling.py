@@ -60,29 +60,39 @@ PRECONDITIONERS = {
     "band2": "band:width=2,radius=1.5,sweeps=4",
     "band3": "band:width=3,radius=3.2,sweeps=8",
     "band4": "band:width=4,radius=4.5,sweeps=16",
+    # Diagnostics: the band's near-field matrix solved exactly (sparse LU) instead of by Jacobi sweeps.
+    "band2-lu": "band:width=2,radius=1.5,sweeps=0",
+    "band8-lu": "band:width=8,radius=3.2,sweeps=0",
+    # The Schur form with the whole coupling by FFT (two pairs per application) and the band's Jacobi M.
+    "schur1": "schur:width=1,radius=1.5,sweeps=1,damping=1",
+    "schur4": "schur:width=4,radius=3.2,sweeps=8,damping=0.5",
 }
 
-# Cold-solve variants of CascadePK (keyword arguments).
+MAIN_PRECONDITIONERS = ("fourier", "band2", "band3")
+
+# Cold-solve variants of CascadePK: every option given (the prototype's defaults are the candidate `best`).
 _NEVER = 1e9  # restart_fraction: Polak-Ribiere+ throughout, never restarted
+_PLAIN = dict(cascade=(), restart_fraction=_NEVER, preconditioner="fourier", prolong="bilinear", point_corrections=0)
 COLD_VARIANTS = {
-    "pcg": dict(cascade=(), restart_fraction=_NEVER),
-    "pcg-restart1%": dict(cascade=(), restart_fraction=0.01),
-    "cascade": dict(cascade=(4, 2), restart_fraction=_NEVER, prolong="signed"),
-    "cascade-bilinear": dict(cascade=(4, 2), restart_fraction=_NEVER),
-    "cascade-restart1%": dict(cascade=(4, 2), restart_fraction=0.01),
-    "pcg-lazy": dict(cascade=(), restart_fraction=_NEVER, lazy_ratio=1.0),
-    "pcg-clipahead": dict(cascade=(), restart_fraction=_NEVER, clip_ahead=1.0),
-    "band2": dict(cascade=(), restart_fraction=_NEVER, preconditioner=PRECONDITIONERS["band2"]),
-    "band3": dict(cascade=(), restart_fraction=_NEVER, preconditioner=PRECONDITIONERS["band3"]),
-    "cascade-band2": dict(cascade=(4, 2), restart_fraction=_NEVER, prolong="signed",
-                          preconditioner=PRECONDITIONERS["band2"]),
-    "cascade-band3": dict(cascade=(4, 2), restart_fraction=_NEVER, prolong="signed",
-                          preconditioner=PRECONDITIONERS["band3"]),
+    "pcg": _PLAIN,
+    "pcg-restart1%": dict(_PLAIN, restart_fraction=0.01),
+    "cascade": dict(_PLAIN, cascade=(4, 2), prolong="signed"),
+    "cascade-bilinear": dict(_PLAIN, cascade=(4, 2)),
+    "cascade-restart1%": dict(_PLAIN, cascade=(4, 2), restart_fraction=0.01),
+    "pcg-lazy": dict(_PLAIN, lazy_ratio=1.0),
+    "pcg-clipahead": dict(_PLAIN, clip_ahead=1.0),
+    "band2": dict(_PLAIN, preconditioner=PRECONDITIONERS["band2"]),
+    "band3": dict(_PLAIN, preconditioner=PRECONDITIONERS["band3"]),
+    "cascade-band2": dict(_PLAIN, cascade=(4, 2), prolong="signed", preconditioner=PRECONDITIONERS["band2"]),
+    "cascade-band3": dict(_PLAIN, cascade=(4, 2), prolong="signed", preconditioner=PRECONDITIONERS["band3"]),
     # The prototype's candidate: cascade N/2^k down to 256, signed prolongation, edge-band preconditioner,
     # few-node projections corrected by kernel copies; and the same with the Fourier preconditioner.
-    "best": dict(cascade="auto", restart_fraction=_NEVER, prolong="signed", preconditioner=PRECONDITIONERS["band2"],
-                 point_corrections=16),
-    "best-fourier": dict(cascade="auto", restart_fraction=_NEVER, prolong="signed", point_corrections=16),
+    "best": dict(cascade="auto", coarsest=256, restart_fraction=_NEVER, prolong="signed",
+                 preconditioner=PRECONDITIONERS["band2"], point_corrections=16),
+    "best-fourier": dict(cascade="auto", coarsest=256, restart_fraction=_NEVER, prolong="signed",
+                         preconditioner="fourier", point_corrections=16),
+    "best-band3": dict(cascade="auto", coarsest=256, restart_fraction=_NEVER, prolong="signed",
+                       preconditioner=PRECONDITIONERS["band3"], point_corrections=16),
 }
 
 
@@ -312,6 +322,20 @@ class ExactBandPC:
         remove_mean_on(out, free, count)
 
 
+def run_gaps(problem, contact, key, rows, path):
+    """How far the nodes outside C lie from C (Chebyshev distance, grid units, periodic): the band width that
+    an exact band must have to cover them."""
+    from scipy.ndimage import distance_transform_cdt
+
+    n = problem.grid.n0
+    outside = ~contact.reshape(n, n)
+    pad = n // 2
+    distance = distance_transform_cdt(np.pad(outside, pad, mode="wrap"), metric="chessboard")[pad:-pad, pad:-pad]
+    values = distance[outside]
+    add_row(rows, path, dict(part="gaps", key=key, variant="distance to C", median=float(np.median(values)),
+                             p90=float(np.percentile(values, 90)), max=float(values.max())))
+
+
 def run_exact_band(problem, pstar, contact, key, width, rows, path):
     from roughpetsc.solvers import pk_cascade
 
@@ -369,6 +393,7 @@ def run_warm(problem, key, name, rows, path):
         seconds = time.perf_counter() - start
         pairs = [r.operator_applications for r in results]
         converged = sum(r.converged for r in results)
+        starts = [r.history[0, 1] for r in results[1:] if len(r.history)]
     else:
         solver = pk_cascade.CascadePK(fine_heights(problem), **COLD_VARIANTS[name])
         try:
@@ -376,13 +401,14 @@ def run_warm(problem, key, name, rows, path):
             cold = solver.solve(problem.scaled_pbar(pstar=0.5), RTOL)
             cold_seconds = time.perf_counter() - start
             cold_pairs = cold.pairs
-            previous, pairs, converged = [], [], 0
+            previous, pairs, converged, starts = [], [], 0, []
             start = time.perf_counter()
             for pstar in loads:
                 pbar = problem.scaled_pbar(pstar=pstar)
                 if previous:
                     p0, u0 = extrapolated_start(previous, loads, pbar)
                     result = solver.solve(pbar, RTOL, start=p0, start_displacement=u0)
+                    starts.append(result.levels[-1].history[0])
                 else:
                     result = solver.solve(pbar, RTOL)
                 pairs.append(result.pairs)
@@ -396,7 +422,8 @@ def run_warm(problem, key, name, rows, path):
     warm = np.mean(pairs[1:])
     add_row(rows, path, dict(part="warm", key=key, variant=name, steps=len(loads), cold_pairs=float(cold_pairs),
                              warm_pairs=float(warm), ratio=float(warm / cold_pairs),
-                             time_ratio=float(seconds / len(loads) / cold_seconds), converged=int(converged)))
+                             time_ratio=float(seconds / len(loads) / cold_seconds), converged=int(converged),
+                             start_residual=float(np.median(starts))))
 
 
 # --- report -----------------------------------------------------------------------------------------------
@@ -486,12 +513,24 @@ def exact_band_table(rows):
                                    f"{r['cond']:.2f}", r["pairs"], r["inner_pairs"]] for r in exact])
 
 
+def gaps_table(rows, keys):
+    table = []
+    for key in keys:
+        found = [r for r in rows_of(rows, "gaps") if r["key"] == key]
+        if found:
+            group, n, pstar = parse_key(key)
+            table.append([group, f"{pstar:g}", n, f"{found[-1]['median']:.0f}", f"{found[-1]['p90']:.0f}",
+                          f"{found[-1]['max']:.0f}"])
+    return common.markdown_table(["group", "p*", "N", "median", "90 %", "max"], table)
+
+
 def warm_table(rows):
     return common.markdown_table(
         ["case", "solver", "steps", "cold pairs (p* = 0.5)", "pairs per warm step", "ratio to its own cold",
-         "time ratio (noisy)", "certified"],
+         "time ratio (noisy)", "median start residual", "certified"],
         [[r["key"], r["variant"], r["steps"], f"{r['cold_pairs']:.1f}", f"{r['warm_pairs']:.1f}", f"{r['ratio']:.3f}",
-          f"{r['time_ratio']:.3f}", f"{r['converged']}/{r['steps']}"] for r in rows_of(rows, "warm")])
+          f"{r['time_ratio']:.3f}", f"{r['start_residual']:.1e}" if "start_residual" in r else "-",
+          f"{r['converged']}/{r['steps']}"] for r in rows_of(rows, "warm")])
 
 
 def report(rows):
@@ -505,14 +544,15 @@ def report(rows):
              "load average of 5-11 (noisy: compare only as ratios, and loosely). Surfaces: `options/group01.opts` "
              "(H = 0.8) and `options/group18.opts` (H = 0.1) at N x N, seed 1; natural KKT residual 1e-8.", "",
              "Preconditioners: `fourier` = the Fourier preconditioner of today's solver; `band<k>` = the edge-band "
-             "preconditioner `pk_cascade.BandPC`: "
-             + "; ".join(f"`{k}` = `{v}`" for k, v in PRECONDITIONERS.items() if k.startswith("band")) + ".", "",
+             "preconditioner `pk_cascade.BandPC` (`-lu`: its band matrix solved exactly, a diagnostic); "
+             "`schur<k>` = `pk_cascade.SchurPC` (two pairs per application): "
+             + "; ".join(f"`{k}` = `{v}`" for k, v in PRECONDITIONERS.items() if k != "fourier") + ".", "",
              "## 1. The floor: preconditioned CG on the exact final contact set", "",
              "Pairs to a certified natural residual of 1e-8 from the uniform pressure on C (2 k + 2 for k "
              "iterations); cond = lambda_max / lambda_min of the preconditioned operator on the zero-sum "
              "subspace of C, from the Lanczos matrix of the CG coefficients (CG run on to a reduction of "
              "1e-10; Ritz values lie inside the spectrum, so lambda_max is a lower and lambda_min an upper "
-             "estimate).", "", floor_table(rows, keys, floor_names), ""]
+             "estimate).", "", floor_table(rows, keys, [n for n in floor_names if n in MAIN_PRECONDITIONERS]), ""]
     if rows_of(rows, "slepc"):
         lines += ["SLEPc cross-check (Krylov-Schur, tolerance 1e-8, the constant on C deflated):", "",
                   slepc_table(rows), ""]
@@ -528,9 +568,15 @@ def report(rows):
               "solver set-up, the variants do not include their grids' FFTW planning; noisy):", "",
               timing_table(rows, keys, cold_names), ""]
     lines += ["## 3. The edge-band preconditioner and its exact limit", "",
-              "The `band<k>` floor columns of section 1 are the practical edge-band preconditioner. Its limit with "
-              "an exact band solve (`ExactBandPC` of the study: S_OO^-1 by an inner CG, the coupling by FFT, "
-              "a diagnostic only: its inner pairs are counted apart) against the band width:", ""]
+              "The `band<k>` floor columns of section 1 are the practical edge-band preconditioner. Other "
+              "settings, the band's near-field matrix solved exactly (`-lu`), and the Schur form with the "
+              "coupling by FFT (`schur<k>`, two pairs per application, counted) on the same floor problem:", "",
+              floor_table(rows, keys, [n for n in floor_names if n not in MAIN_PRECONDITIONERS]), "",
+              "How far the nodes outside C lie from C (Chebyshev distance in nodes; `gaps` part):", "",
+              gaps_table(rows, keys), "",
+              "The limit with an exact band solve (`ExactBandPC` of the study: S_OO^-1 by an inner CG, the "
+              "coupling by FFT, a diagnostic only: its inner pairs are counted apart) against the band width:",
+              ""]
     lines += [exact_band_table(rows) if rows_of(rows, "exactband") else "(not run)", ""]
     lines += ["## 4. Warm steps along the load history (7.11)", ""]
     lines += [warm_table(rows) if rows_of(rows, "warm") else "(not run)", ""]
@@ -584,7 +630,7 @@ def main():
     parser.add_argument("--loads", type=float, nargs="*", default=[0.05, 0.5, 2.0])
     parser.add_argument("--groups", type=int, nargs="*", default=[1, 18])
     parser.add_argument("--parts", nargs="*", default=["reference", "pk", "floor", "cold"],
-                        choices=["reference", "pk", "floor", "cold", "slepc", "warm", "exactband"])
+                        choices=["reference", "pk", "floor", "cold", "slepc", "warm", "exactband", "gaps"])
     parser.add_argument("--widths", type=int, nargs="*", default=[1, 2, 4, 8],
                         help="band widths of the exactband diagnostic")
     parser.add_argument("--floor-pcs", nargs="*", default=["fourier", "band2"], choices=list(PRECONDITIONERS))
@@ -621,17 +667,20 @@ def run_case(args, group, n, pstar, rows, path):
     warms = [name for name in args.warm if "warm" in args.parts and n == args.warm_n and pstar == 0.5
              and not has_row(rows, "warm", key, name)]
     widths = [w for w in args.widths if "exactband" in args.parts and not has_row(rows, "exactband", key, f"width {w}")]
-    if not (todo or floors or colds or slepcs or warms or widths):
+    gaps = "gaps" in args.parts and not has_row(rows, "gaps", key, "distance to C")
+    if not (todo or floors or colds or slepcs or warms or widths or gaps):
         return
     print(f"--- {key}", flush=True)
     problem = make_problem(group, n)
     try:
         if "pk" in todo:
             run_pk(problem, pstar, key, rows, path)
-        if floors or slepcs or widths or "reference" in todo:
+        if floors or slepcs or widths or gaps or "reference" in todo:
             contact = reference_contact(problem, pstar, args.cache, key, rows, path)
         for name in floors:
             run_floor(problem, pstar, contact, key, name, rows, path)
+        if gaps:
+            run_gaps(problem, contact, key, rows, path)
         for width in widths:
             run_exact_band(problem, pstar, contact, key, width, rows, path)
         for name in slepcs:

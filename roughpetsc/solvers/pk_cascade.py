@@ -28,6 +28,8 @@ What is here
     term, i.e. takes the displacement outside F to be zero, which overestimates the stiffness of the
     modes at the contact edge (the large eigenvalues of ``B K`` there). ``E' S E`` is symmetric positive
     definite for any symmetric M, and costs one FFT pair plus local stencil work on the band.
+  - :class:`SchurPC` ``B = P (S_FF - S_FO M S_OF) P``: the same Schur term with the coupling by FFT (two
+    pairs per application); measured worse per pair than :class:`BandPC` (the study's ``schur*`` rows).
 
 * :func:`fixed_set_pcg`: preconditioned CG on a fixed contact set (the floor of issue 39, item 1), its CG
   coefficients, and :func:`lanczos_extremes`, the extreme eigenvalues of the preconditioned operator on
@@ -320,8 +322,17 @@ class BandPC:
                                                                    np.concatenate(oo_cols))), shape=(size, size))
 
     def _solve_band(self, rhs):
-        """``M rhs``: damped Jacobi sweeps on the band (the valid nodes) from u = 0."""
+        """``M rhs``: damped Jacobi sweeps on the band (the valid nodes) from u = 0; ``sweeps=0``: the
+        near-field band matrix ``D + A_OO`` solved exactly (sparse LU; a diagnostic of the stencil's limit)."""
         rhs = rhs * self.valid
+        if self.sweeps == 0:
+            if getattr(self, "_factor_for", None) is not self.within:
+                from scipy import sparse
+                from scipy.sparse.linalg import splu
+
+                matrix = (self.within + sparse.identity(self.band.size) * self.diagonal).tocsc()
+                self._factor, self._factor_for = splu(matrix), self.within
+            return self._factor.solve(rhs) * self.valid
         u = self.damping / self.diagonal * rhs
         for _ in range(self.sweeps - 1):
             u += self.damping / self.diagonal * (rhs - self.within @ u - self.diagonal * u)
@@ -337,17 +348,40 @@ class BandPC:
         remove_mean_on(out, free, count)
 
 
+class SchurPC(BandPC):
+    """The Schur-complement preconditioner ``B = P (S_FF - S_FO M S_OF) P`` with the whole coupling by FFT.
+
+    Two FFT pairs per application: ``y = S r`` gives ``S_OF r`` on the band O exactly (every range, not
+    the near field), ``w = M y_O`` with M the band's Jacobi polynomial (:class:`BandPC`), and
+    ``B r = y - S w`` on F. ``K_FF^-1 = S_FF - S_FO S_OO^-1 S_OF`` exactly when O is every node outside F
+    and ``M = S_OO^-1``; B is symmetric, and positive definite when ``M <= S_OO^-1`` (damped Jacobi with
+    ``damping <= 1 / lambda_max(D^-1 S_OO)``, about 0.5 here).
+    """
+
+    name = "schur"
+
+    def apply(self, r, out, free, count):
+        self.level.stiffness(r, out)
+        extended = self.extended
+        extended[...] = 0.0
+        extended[self.band] = self._solve_band(out[self.band])
+        correction = np.empty_like(out)
+        self.level.stiffness(extended, correction)
+        out -= correction
+        remove_mean_on(out, free, count)
+
+
 def make_preconditioner(level, spec):
     """A preconditioner from its spec: ``"fourier"`` or ``"band:width=1,radius=1.5,sweeps=1,damping=1"``."""
     name, _, arguments = spec.partition(":")
     if name == "fourier":
         return FourierPC(level)
-    if name == "band":
+    if name in ("band", "schur"):
         kwargs = {}
         for item in filter(None, arguments.split(",")):
             key, value = item.split("=")
             kwargs[key] = float(value) if key in ("radius", "damping", "rebuild") else int(value)
-        return BandPC(level, **kwargs)
+        return (BandPC if name == "band" else SchurPC)(level, **kwargs)
     raise ValueError(f"unknown preconditioner '{spec}' (fourier, band:...)")
 
 
@@ -369,7 +403,7 @@ class FixedSetRun:
     """What :func:`fixed_set_pcg` returns.
 
     pairs : FFT pairs to the tolerance, the first K p and the certificate included (``2 k + 2`` for k
-        iterations); None if the tolerance was not reached.
+        iterations of a one-pair preconditioner); None if the tolerance was not reached.
     iterations : CG iterations to the tolerance.
     certified : natural residual on a fresh gap at that point.
     alphas, betas : CG coefficients of every iteration run (for :func:`lanczos_extremes`).
@@ -398,6 +432,7 @@ def fixed_set_pcg(level, contact, pbar, preconditioner, rtol=1e-8, extra_rtol=No
     """
     size = contact.size
     count = int(contact.sum())
+    start_pairs = level.pairs
     p = np.where(contact, size * pbar / count, 0.0)
     u, q, z, t, r = (np.zeros(size) for _ in range(5))
     level.compliance(p, u)
@@ -420,7 +455,7 @@ def fixed_set_pcg(level, contact, pbar, preconditioner, rtol=1e-8, extra_rtol=No
             gap = fresh - level.h
             gap += -gap[contact].mean()
             run.certified = natural_residual(p, gap, pbar)
-            run.pairs, run.iterations = 2 * iteration + 2, iteration
+            run.pairs, run.iterations = level.pairs - start_pairs, iteration
             if extra_rtol is None:
                 break
         if run.pairs is not None and (extra_rtol is None or r_norm <= extra_rtol * r0):
@@ -501,6 +536,7 @@ class CascadeOptions:
     preconditioner: str = "band:width=2,radius=1.5,sweeps=4"
     restrict: str = "inject"
     prolong: str = "signed"
+    prolong_scale: float = 1.0
     point_corrections: int = 16
     max_it: int = 5000
     lazy_until: float = np.inf
@@ -598,7 +634,7 @@ class CascadePK:
     def _prolongate(self, p_coarse, gap_coarse, coarse, fine, pbar):
         m = coarse.n
         if self.options.prolong == "signed":
-            scale = coarse.stiffness_stencil(0.0)[1][0]
+            scale = self.options.prolong_scale * coarse.stiffness_stencil(0.0)[1][0]
             signed = p_coarse - scale * np.maximum(gap_coarse, 0.0)
             p = np.maximum(prolong_bilinear(signed.reshape(m, m)), 0.0).ravel()
         else:
