@@ -91,6 +91,8 @@ COLD_VARIANTS = {
                  preconditioner=PRECONDITIONERS["band2"], point_corrections=16),
     "best-fourier": dict(cascade="auto", coarsest=256, restart_fraction=_NEVER, prolong="signed",
                          preconditioner="fourier", point_corrections=16),
+    "best-tight": dict(cascade="auto", coarsest=256, coarse_rtol=1e-4, restart_fraction=_NEVER, prolong="signed",
+                       preconditioner=PRECONDITIONERS["band2"], point_corrections=16),
     "best-band3": dict(cascade="auto", coarsest=256, restart_fraction=_NEVER, prolong="signed",
                        preconditioner=PRECONDITIONERS["band3"], point_corrections=16),
 }
