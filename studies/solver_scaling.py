@@ -26,14 +26,14 @@ Parts (``--parts``):
   ``n pbar / |C|`` on C: the set and nothing else is known), until the natural KKT residual of the whole
   grid, ``max |min(p/pbar, g)|`` on the updated gap, is at most 1e-8 and then on a fresh gap (the
   certificate): pairs = 1 (first K p) + 2 per iteration (B r, K t) + 1 (certificate)
-  (:func:`roughpetsc.solvers.pk_cascade.fixed_set_pcg`). CG then runs on to a residual reduction of 1e-10
+  (:func:`pk_cascade.fixed_set_pcg`). CG then runs on to a residual reduction of 1e-10
   for the spectrum: the extreme eigenvalues of the preconditioned operator restricted to C (zero-sum
   subspace) are the extreme eigenvalues of the Lanczos matrix of its coefficients. One preconditioner per
   ``--floor-pcs`` name (:data:`PRECONDITIONERS`).
-- ``cold``: cold solves by the prototype :class:`roughpetsc.solvers.pk_cascade.CascadePK`, one per
+- ``cold``: cold solves by the prototype :class:`pk_cascade.CascadePK`, one per
   ``--cold`` variant (:data:`COLD_VARIANTS`): FFT pairs of every level weighted by (N_c/N)^2, the
   certificate included, and an independent certificate afterwards (a fresh gap through
-  ``ContactProblem.gap`` and ``roughpetsc.kkt.report``, not counted).
+  ``ContactProblem.gap`` and ``roughpetsc.contact.certificate.report``, not counted).
 - ``slepc``: the Lanczos estimates checked against SLEPc (Krylov-Schur on ``B P K_CC P``, the constant on
   C deflated) at the smallest size and load given.
 - ``warm``: the load history (7.11) (95 steps) at ``--warm-n``: pairs per warm step against one cold solve
@@ -165,7 +165,7 @@ def fine_heights(problem):
 
 
 def run_floor(problem, pstar, contact, key, name, rows, path):
-    from roughpetsc.solvers import pk_cascade
+    import pk_cascade
 
     n = problem.grid.n0
     level = pk_cascade.Level(fine_heights(problem), n)
@@ -185,7 +185,7 @@ def run_floor(problem, pstar, contact, key, name, rows, path):
 
 def certify(problem, pressure, separation, pbar):
     """The natural residual and load error of a scaled pressure on a fresh gap (one uncounted pair)."""
-    from roughpetsc.kkt import report
+    from roughpetsc.contact.certificate import report
 
     p_vec, gap = problem.vec(), problem.vec()
     try:
@@ -200,7 +200,7 @@ def certify(problem, pressure, separation, pbar):
 
 
 def run_cold(problem, pstar, key, name, rows, path):
-    from roughpetsc.solvers import pk_cascade
+    import pk_cascade
 
     pbar = problem.scaled_pbar(pstar=pstar)
     start = time.perf_counter()
@@ -226,7 +226,7 @@ def run_slepc(problem, pstar, contact, key, name, rows, path):
     from petsc4py import PETSc
     from slepc4py import SLEPc
 
-    from roughpetsc.solvers import pk_cascade
+    import pk_cascade
 
     n = problem.grid.n0
     level = pk_cascade.Level(fine_heights(problem), n)
@@ -316,7 +316,7 @@ class ExactBandPC:
         return x
 
     def apply(self, r, out, free, count):
-        from roughpetsc.solvers.pk_cascade import remove_mean_on
+        from pk_cascade import remove_mean_on
 
         y = self._stiffness(r)
         self.level.pairs += 1  # the one pair a practical preconditioner would also spend
@@ -339,7 +339,7 @@ def run_gaps(problem, contact, key, rows, path):
 
 
 def run_exact_band(problem, pstar, contact, key, width, rows, path):
-    from roughpetsc.solvers import pk_cascade
+    import pk_cascade
 
     level = pk_cascade.Level(fine_heights(problem), problem.grid.n0)
     try:
@@ -372,7 +372,7 @@ def extrapolated_start(previous, loads, target):
 def run_warm(problem, key, name, rows, path):
     """Pairs per step of the load history (7.11) warm-started, against a cold solve at p* = 0.5."""
     from roughpetsc import load_history
-    from roughpetsc.solvers import pk_cascade
+    import pk_cascade
 
     loads = load_history()
     if name == "pk":
@@ -541,7 +541,7 @@ def report(rows):
     cold_names = [n for n in COLD_VARIANTS if any(r["variant"] == n for r in rows_of(rows, "cold"))]
     lines = ["# The contact solver's floor, cold solves against it, and warm load steps (issue 39, items 1-4)", "",
              "Written by `studies/solver_scaling.py` from its `rows*.json` (its docstring defines every quantity; "
-             "`roughpetsc/solvers/pk_cascade.py` describes the prototype solver step by step). FFT pairs and "
+             "`studies/pk_cascade.py` describes the prototype solver step by step). FFT pairs and "
              "iterations are deterministic; seconds come from one run each on a shared 2-core machine under a "
              "load average of 5-11 (noisy: compare only as ratios, and loosely). Surfaces: `options/group01.opts` "
              "(H = 0.8) and `options/group18.opts` (H = 0.1) at N x N, seed 1; natural KKT residual 1e-8.", "",

@@ -1,18 +1,31 @@
-"""The cascaded PK prototype of issue 39 (roughpetsc/solvers/pk_cascade.py).
+"""The cascaded PK prototype of issue 39 (studies/pk_cascade.py, a study's solver: serial, not a backend yet).
 
 References: today's Polonsky-Keer (an independent implementation) for the solution; dense eigenvalues
 (numpy) for the Lanczos estimates of the spectrum and for the symmetry and definiteness of the edge-band
 preconditioner; a direct evaluation of the compliance for the kernel-copy corrections.
 """
 
+import importlib.util
+import os
+
 import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from roughpetsc.contact import ContactProblem
-from roughpetsc.control import Solver
-from roughpetsc.solvers import pk_cascade
-from roughpetsc.surfaces import Grid, fractal
+from roughpetsc import ContactProblem, Grid, Solver, fractal
+
+from conftest import ROOT
+
+
+def load_prototype():
+    """studies/pk_cascade.py as a module (the studies are scripts, not a package)."""
+    spec = importlib.util.spec_from_file_location("pk_cascade", os.path.join(ROOT, "studies", "pk_cascade.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+pk_cascade = load_prototype()
 
 EFFORT = "FFTW_ESTIMATE"
 

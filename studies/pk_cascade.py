@@ -1,6 +1,6 @@
 """Cascaded Polonsky-Keer under load control, and an edge-band preconditioner: a prototype (issue 39).
 
-Self-contained (numpy and numba on one rank, the operators of :class:`~roughpetsc.westergaard.Westergaard`),
+Self-contained (numpy and numba on one rank, the operators of :class:`~roughpetsc.Westergaard`),
 so that it can be ported into the solver stack as a backend. Everything is in the scaled units of
 :class:`~roughpetsc.contact.ContactProblem` (rms height 1, cell length 1, E* = 1).
 
@@ -9,7 +9,7 @@ The problem (3.41)-(3.44) of the dissertation under load control::
     min 1/2 p'Kp - h'p   subject to   p >= 0,   mean(p) = pbar,
 
 with the gap ``g = K p + d - h`` (d the rigid separation, the multiplier of the load) and the natural
-KKT residual ``max |min(p / pbar, g)|`` (:mod:`roughpetsc.kkt`, docs/conventions.md).
+KKT residual ``max |min(p / pbar, g)|`` (:mod:`roughpetsc.contact.certificate`, docs/conventions.md).
 
 What is here
 ------------
@@ -73,8 +73,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from petsc4py import PETSc
 
-from ..surfaces import Grid
-from ..westergaard import Westergaard
+from roughpetsc import Grid, Westergaard
 
 
 # --- grids ------------------------------------------------------------------------------------------------
