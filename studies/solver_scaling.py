@@ -1,0 +1,699 @@
+"""The contact solver's floor, its spectrum, cold solves against it, and warm load steps (issue 39, items 1-4).
+
+    .venv/bin/python studies/solver_scaling.py [--sizes 256 512 1024 2048] [--loads 0.05 0.5 2] [--groups 1 18]
+        [--parts reference pk floor cold] [--floor-pcs fourier band2 band3] [--cold VARIANT ...]
+        [--warm-n 1024] [--report]
+
+Resumable: every row (one measurement) is kept in ``studies/output/solver_scaling/rows.json`` as soon as it
+is made, and a row already there is not remade; ``--report`` writes ``report.md`` and the plots from the
+rows alone. Every count is deterministic (FFT pairs, iterations); wall times are from one run on a shared,
+loaded machine and only their ratios within one run mean anything.
+
+Surfaces: ``options/groupNN.opts`` (``fractal_group``) at N x N with the preset's generator ``xu`` and the
+command line's default seed 1, i.e. the surface of
+``python -m roughpetsc -options_file options/groupNN.opts -surface_N N -pstar P``; scaled units of
+:class:`~roughpetsc.ContactProblem`; tolerance: natural KKT residual 1e-8.
+
+Parts (``--parts``):
+
+- ``reference``: today's default solver (Polonsky-Keer, BCCG active set, Fourier preconditioner) to a natural
+  residual of 1e-12. Its contact set {p > 0} is *the exact final contact set* C (kept as a bit mask in
+  ``--cache``, outside the repository).
+- ``pk``: today's default solver, cold, to 1e-8 (``common.solve``: the Solver facade, its certificate
+  included): iterations, FFT pairs (``operator.applications``), seconds.
+- ``floor``: *the floor*: preconditioned CG on the fixed set C for the load-controlled QP
+  (``K_CC p + d = h_C``, ``sum p = n pbar``, p = 0 off C), from the natural start (the uniform pressure
+  ``n pbar / |C|`` on C: the set and nothing else is known), until the natural KKT residual of the whole
+  grid, ``max |min(p/pbar, g)|`` on the updated gap, is at most 1e-8 and then on a fresh gap (the
+  certificate): pairs = 1 (first K p) + 2 per iteration (B r, K t) + 1 (certificate)
+  (:func:`pk_cascade.fixed_set_pcg`). CG then runs on to a residual reduction of 1e-10
+  for the spectrum: the extreme eigenvalues of the preconditioned operator restricted to C (zero-sum
+  subspace) are the extreme eigenvalues of the Lanczos matrix of its coefficients. One preconditioner per
+  ``--floor-pcs`` name (:data:`PRECONDITIONERS`).
+- ``cold``: cold solves by the prototype :class:`pk_cascade.CascadePK`, one per
+  ``--cold`` variant (:data:`COLD_VARIANTS`): FFT pairs of every level weighted by (N_c/N)^2, the
+  certificate included, and an independent certificate afterwards (a fresh gap through
+  ``ContactProblem.gap`` and ``roughpetsc.contact.certificate.report``, not counted).
+- ``slepc``: the Lanczos estimates checked against SLEPc (Krylov-Schur on ``B P K_CC P``, the constant on
+  C deflated) at the smallest size and load given.
+- ``warm``: the load history (7.11) (95 steps) at ``--warm-n``: pairs per warm step against one cold solve
+  at p* = 0.5, for today's solver (``roughpetsc.load_path``'s linear predictor) and for the prototype with
+  the same predictor.
+"""
+
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+import common
+
+OUT = os.path.join(common.OUTPUT, "solver_scaling")
+RTOL = 1e-8
+
+# Preconditioners of the floor runs (specs of pk_cascade.make_preconditioner).
+PRECONDITIONERS = {
+    "fourier": "fourier",
+    "band1": "band:width=1,radius=1.5,sweeps=1",
+    "band2": "band:width=2,radius=1.5,sweeps=4",
+    "band3": "band:width=3,radius=3.2,sweeps=8",
+    "band4": "band:width=4,radius=4.5,sweeps=16",
+    # Diagnostics: the band's near-field matrix solved exactly (sparse LU) instead of by Jacobi sweeps.
+    "band2-lu": "band:width=2,radius=1.5,sweeps=0",
+    "band8-lu": "band:width=8,radius=3.2,sweeps=0",
+    # The Schur form with the whole coupling by FFT (two pairs per application) and the band's Jacobi M.
+    "schur1": "schur:width=1,radius=1.5,sweeps=1,damping=1",
+    "schur4": "schur:width=4,radius=3.2,sweeps=8,damping=0.5",
+}
+
+MAIN_PRECONDITIONERS = ("fourier", "band2", "band3")
+
+# Cold-solve variants of CascadePK: every option given (the prototype's defaults are the candidate `best`).
+_NEVER = 1e9  # restart_fraction: Polak-Ribiere+ throughout, never restarted
+_PLAIN = dict(cascade=(), restart_fraction=_NEVER, preconditioner="fourier", prolong="bilinear", point_corrections=0)
+COLD_VARIANTS = {
+    "pcg": _PLAIN,
+    "pcg-restart1%": dict(_PLAIN, restart_fraction=0.01),
+    "cascade": dict(_PLAIN, cascade=(4, 2), prolong="signed"),
+    "cascade-bilinear": dict(_PLAIN, cascade=(4, 2)),
+    "cascade-restart1%": dict(_PLAIN, cascade=(4, 2), restart_fraction=0.01),
+    "pcg-lazy": dict(_PLAIN, lazy_ratio=1.0),
+    "pcg-clipahead": dict(_PLAIN, clip_ahead=1.0),
+    "band2": dict(_PLAIN, preconditioner=PRECONDITIONERS["band2"]),
+    "band3": dict(_PLAIN, preconditioner=PRECONDITIONERS["band3"]),
+    "cascade-band2": dict(_PLAIN, cascade=(4, 2), prolong="signed", preconditioner=PRECONDITIONERS["band2"]),
+    "cascade-band3": dict(_PLAIN, cascade=(4, 2), prolong="signed", preconditioner=PRECONDITIONERS["band3"]),
+    # The prototype's candidate: cascade N/2^k down to 256, signed prolongation, edge-band preconditioner,
+    # few-node projections corrected by kernel copies; and the same with the Fourier preconditioner.
+    "best": dict(cascade="auto", coarsest=256, restart_fraction=_NEVER, prolong="signed",
+                 preconditioner=PRECONDITIONERS["band2"], point_corrections=16),
+    "best-fourier": dict(cascade="auto", coarsest=256, restart_fraction=_NEVER, prolong="signed",
+                         preconditioner="fourier", point_corrections=16),
+    "best-tight": dict(cascade="auto", coarsest=256, coarse_rtol=1e-4, restart_fraction=_NEVER, prolong="signed",
+                       preconditioner=PRECONDITIONERS["band2"], point_corrections=16),
+    "best-band3": dict(cascade="auto", coarsest=256, restart_fraction=_NEVER, prolong="signed",
+                       preconditioner=PRECONDITIONERS["band3"], point_corrections=16),
+}
+
+
+# --- problems and the reference contact set ----------------------------------------------------------------
+def make_problem(group, n):
+    """The surface of ``options/groupNN.opts`` at n x n (generator xu, seed 1), E* = 1, one process."""
+    from petsc4py import PETSc
+
+    from roughpetsc import ContactProblem, Grid, fractal, fractal_group
+
+    preset = fractal_group(group)
+    grid = Grid(n, n, preset["length"], preset["length"])
+    heights = fractal(grid, preset["k_l"], preset["k_s"], preset["hurst"], preset["m2"], seed=1, generator="xu")
+    return ContactProblem(grid, heights, 1.0, PETSc.COMM_SELF)
+
+
+def case_key(group, n, pstar):
+    return f"g{group:02d}_N{n}_p{pstar:g}"
+
+
+def contact_path(cache, key):
+    return os.path.join(cache, key + ".contact.npz")
+
+
+def reference_contact(problem, pstar, cache, key, rows, path):
+    """The exact final contact set of the case (bool, flat): from the cache, or by today's solver to 1e-12."""
+    file = contact_path(cache, key)
+    if os.path.exists(file):
+        with np.load(file) as saved:
+            return np.unpackbits(saved["bits"], count=problem.n).astype(bool)
+    result, pressure, seconds = common.solve(problem, {}, 1e-12, pstar=pstar)
+    contact = pressure.ravel() > 0
+    os.makedirs(cache, exist_ok=True)
+    np.savez(file + ".partial.npz", bits=np.packbits(contact))
+    os.replace(file + ".partial.npz", file)
+    add_row(rows, path, dict(part="reference", key=key, variant="pk 1e-12", iterations=result.iterations,
+                             pairs=result.operator_applications, natural=result.kkt.natural, A=result.A,
+                             contact=int(contact.sum()), converged=result.converged, seconds=seconds))
+    return contact
+
+
+# --- rows -------------------------------------------------------------------------------------------------
+def has_row(rows, part, key, variant):
+    return any(r["part"] == part and r["key"] == key and r["variant"] == variant for r in rows)
+
+
+def add_row(rows, path, row):
+    rows.append(row)
+    common.save_rows(path, rows)
+    print(" ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()), flush=True)
+
+
+def parse_key(key):
+    group, n, pstar = key.split("_")
+    return int(group[1:]), int(n[1:]), float(pstar[1:])
+
+
+# --- parts ------------------------------------------------------------------------------------------------
+def run_pk(problem, pstar, key, rows, path):
+    result, _, seconds = common.solve(problem, {}, RTOL, pstar=pstar)
+    add_row(rows, path, dict(part="pk", key=key, variant="pk", iterations=result.iterations,
+                             pairs=result.operator_applications, natural=result.kkt.natural,
+                             converged=result.converged, seconds=seconds))
+
+
+def fine_heights(problem):
+    return problem.local(problem.heights, readonly=True).copy()
+
+
+def run_floor(problem, pstar, contact, key, name, rows, path):
+    import pk_cascade
+
+    n = problem.grid.n0
+    level = pk_cascade.Level(fine_heights(problem), n)
+    try:
+        start = time.perf_counter()
+        preconditioner = pk_cascade.make_preconditioner(level, PRECONDITIONERS[name])
+        run = pk_cascade.fixed_set_pcg(level, contact, problem.scaled_pbar(pstar=pstar), preconditioner, RTOL,
+                                       extra_rtol=1e-10)
+        seconds = time.perf_counter() - start
+        low, high, steps = pk_cascade.lanczos_extremes(run.alphas, run.betas)
+    finally:
+        level.destroy()
+    add_row(rows, path, dict(part="floor", key=key, variant=name, pairs=run.pairs, iterations=run.iterations,
+                             certified=run.certified, lambda_min=low, lambda_max=high, cond=high / low,
+                             lanczos_steps=steps, contact=int(contact.sum()), seconds=seconds))
+
+
+def certify(problem, pressure, separation, pbar):
+    """The natural residual and load error of a scaled pressure on a fresh gap (one uncounted pair)."""
+    from roughpetsc.contact.certificate import report
+
+    p_vec, gap = problem.vec(), problem.vec()
+    try:
+        problem.local(p_vec)[...] = pressure.reshape(problem.operator.local_shape)
+        problem.gap(p_vec, separation, gap)
+        kkt = report(problem.mpi, problem.local(p_vec, readonly=True), problem.local(gap, readonly=True),
+                     problem.n, pbar)
+    finally:
+        p_vec.destroy()
+        gap.destroy()
+    return kkt
+
+
+def run_cold(problem, pstar, key, name, rows, path):
+    import pk_cascade
+
+    pbar = problem.scaled_pbar(pstar=pstar)
+    start = time.perf_counter()
+    solver = pk_cascade.CascadePK(fine_heights(problem), **COLD_VARIANTS[name])
+    setup = time.perf_counter() - start
+    try:
+        start = time.perf_counter()
+        result = solver.solve(pbar, RTOL)
+        seconds = time.perf_counter() - start
+    finally:
+        solver.destroy()
+    kkt = certify(problem, result.pressure, result.separation, pbar)
+    levels = "; ".join(f"{lv.n}: {lv.iterations} its {lv.pairs} pairs {lv.corrections} corr" for lv in result.levels)
+    add_row(rows, path, dict(part="cold", key=key, variant=name, pairs=result.pairs,
+                             iterations=result.levels[-1].iterations, natural=kkt.natural,
+                             load_error=kkt.load_error,
+                             converged=bool(kkt.natural <= RTOL and kkt.load_error <= RTOL),
+                             levels=levels, seconds=seconds, setup_seconds=setup))
+
+
+def run_slepc(problem, pstar, contact, key, name, rows, path):
+    """Extreme eigenvalues of ``B P K_CC P`` on the zero-sum subspace of C by SLEPc (Krylov-Schur)."""
+    from petsc4py import PETSc
+    from slepc4py import SLEPc
+
+    import pk_cascade
+
+    n = problem.grid.n0
+    level = pk_cascade.Level(fine_heights(problem), n)
+    preconditioner = pk_cascade.make_preconditioner(level, PRECONDITIONERS[name])
+    preconditioner.setup(contact)
+    free = np.flatnonzero(contact)
+    count = free.size
+    full, response, out = np.zeros(problem.n), np.zeros(problem.n), np.zeros(problem.n)
+
+    class Operator:
+        def mult(self, mat, x, y):
+            full[...] = 0.0
+            full[free] = x.getArray(readonly=True)
+            pk_cascade.remove_mean_on(full, contact, count)
+            level.compliance(full, response)
+            pk_cascade.remove_mean_on(response, contact, count)
+            preconditioner.apply(response, out, contact, count)
+            y.getArray()[...] = out[free]
+
+    mat = PETSc.Mat().createPython((count, count), context=Operator(), comm=PETSc.COMM_SELF)
+    mat.setUp()
+    constant = mat.createVecLeft()
+    constant.set(1.0 / np.sqrt(count))
+    values = []
+    start = time.perf_counter()
+    for which in (SLEPc.EPS.Which.SMALLEST_REAL, SLEPc.EPS.Which.LARGEST_REAL):
+        eps = SLEPc.EPS().create(PETSc.COMM_SELF)
+        eps.setOperators(mat)
+        eps.setProblemType(SLEPc.EPS.ProblemType.NHEP)
+        eps.setDeflationSpace([constant])
+        eps.setWhichEigenpairs(which)
+        eps.setDimensions(nev=1, ncv=64)
+        eps.setTolerances(tol=1e-8, max_it=20000)
+        eps.solve()
+        values.append(eps.getEigenvalue(0).real if eps.getConverged() else float("nan"))
+        eps.destroy()
+    mat.destroy()
+    level.destroy()
+    add_row(rows, path, dict(part="slepc", key=key, variant=name, lambda_min=values[0], lambda_max=values[1],
+                             cond=values[1] / values[0], seconds=time.perf_counter() - start))
+
+
+class ExactBandPC:
+    """Diagnostic, not a practical preconditioner: ``B = P (S_FF - S_FO S_OO^-1 S_OF) P`` with the band O of
+    the nodes outside F within ``width`` of F, S applied by FFT and ``S_OO^-1`` by an inner CG (Jacobi
+    preconditioned, to a relative residual of 1e-10): what the edge-band preconditioner tends to when its
+    near-field stencil and Jacobi sweeps are made exact. With O every node outside F it is the exact
+    inverse of K_FF (S = K^-1 on the grid), so cond = 1. Its inner pairs are counted apart."""
+
+    name = "exactband"
+
+    def __init__(self, level, width, inner_rtol=1e-10):
+        self.level, self.width, self.inner_rtol = level, width, inner_rtol
+        self.inner_pairs = 0
+        self.diagonal = level.stiffness_stencil(0.0)[1][0]
+        self.band = None
+
+    def setup(self, free):
+        from scipy.ndimage import maximum_filter
+
+        n = self.level.n
+        near = maximum_filter(free.reshape(n, n), size=2 * self.width + 1, mode="wrap").ravel()
+        self.band = near & ~free
+
+    def _stiffness(self, x):
+        out = np.empty_like(x)
+        self.level.stiffness(x, out)
+        self.level.pairs -= 1
+        self.inner_pairs += 1
+        return out
+
+    def _solve_band(self, rhs):
+        band = self.band
+        x, r = np.zeros_like(rhs), np.where(band, rhs, 0.0)
+        z = r / self.diagonal
+        t, rz, r0 = z.copy(), r @ z, np.linalg.norm(r)
+        for _ in range(1000):
+            if np.linalg.norm(r) <= self.inner_rtol * r0:
+                break
+            q = np.where(band, self._stiffness(t), 0.0)
+            step = rz / (t @ q)
+            x += step * t
+            r -= step * q
+            z = r / self.diagonal
+            rz, rz_old = r @ z, rz
+            t = z + rz / rz_old * t
+        return x
+
+    def apply(self, r, out, free, count):
+        from pk_cascade import remove_mean_on
+
+        y = self._stiffness(r)
+        self.level.pairs += 1  # the one pair a practical preconditioner would also spend
+        out[...] = y + self._stiffness(self._solve_band(-y))  # y_F - S_FO S_OO^-1 y_O, y_O = S_OF r
+        remove_mean_on(out, free, count)
+
+
+def run_gaps(problem, contact, key, rows, path):
+    """How far the nodes outside C lie from C (Chebyshev distance, grid units, periodic): the band width that
+    an exact band must have to cover them."""
+    from scipy.ndimage import distance_transform_cdt
+
+    n = problem.grid.n0
+    outside = ~contact.reshape(n, n)
+    pad = n // 2
+    distance = distance_transform_cdt(np.pad(outside, pad, mode="wrap"), metric="chessboard")[pad:-pad, pad:-pad]
+    values = distance[outside]
+    add_row(rows, path, dict(part="gaps", key=key, variant="distance to C", median=float(np.median(values)),
+                             p90=float(np.percentile(values, 90)), max=float(values.max())))
+
+
+def run_exact_band(problem, pstar, contact, key, width, rows, path):
+    import pk_cascade
+
+    level = pk_cascade.Level(fine_heights(problem), problem.grid.n0)
+    try:
+        preconditioner = ExactBandPC(level, width)
+        run = pk_cascade.fixed_set_pcg(level, contact, problem.scaled_pbar(pstar=pstar), preconditioner, RTOL,
+                                       extra_rtol=1e-10)
+        low, high, steps = pk_cascade.lanczos_extremes(run.alphas, run.betas)
+    finally:
+        level.destroy()
+    add_row(rows, path, dict(part="exactband", key=key, variant=f"width {width}", pairs=run.pairs,
+                             iterations=run.iterations, lambda_min=low, lambda_max=high, cond=high / low,
+                             inner_pairs=preconditioner.inner_pairs))
+
+
+# --- warm steps along the load history ---------------------------------------------------------------------
+def extrapolated_start(previous, loads, target):
+    """The load path's linear predictor: the last two solutions extrapolated in the load (step ratio capped at
+    2), projected onto p >= 0; the caller scales it to the load. ``previous``: [(pbar, p, K p)]."""
+    if len(previous) == 1:
+        return previous[-1][1].copy(), previous[-1][2].copy()
+    (b0, p0, u0), (b1, p1, u1) = previous[-2], previous[-1]
+    ratio = min((target - b1) / (b1 - b0), 2.0) if b1 != b0 else 0.0
+    p = p1 + ratio * (p1 - p0)
+    u = u1 + ratio * (u1 - u0)
+    if (p < 0).any():
+        return np.maximum(p, 0.0), None  # the projection moved p: K p of the start is computed afresh
+    return p, u
+
+
+def run_warm(problem, key, name, rows, path):
+    """Pairs per step of the load history (7.11) warm-started, against a cold solve at p* = 0.5."""
+    from roughpetsc import load_history
+    import pk_cascade
+
+    loads = load_history()
+    if name == "pk":
+        from roughpetsc import Solver
+
+        solver = Solver(problem, "load", None, RTOL)
+        try:
+            start = time.perf_counter()
+            cold = solver.solve(pstar=0.5)
+            cold_seconds = time.perf_counter() - start
+        finally:
+            solver.destroy()
+        cold_pairs = cold.operator_applications
+        solver = Solver(problem, "load", None, RTOL)
+        start = time.perf_counter()
+        try:
+            results = [solver.solve(pstar=p) for p in loads]
+        finally:
+            solver.destroy()
+        seconds = time.perf_counter() - start
+        pairs = [r.operator_applications for r in results]
+        converged = sum(r.converged for r in results)
+        starts = [r.history[0, 1] for r in results[1:] if len(r.history)]
+    else:
+        solver = pk_cascade.CascadePK(fine_heights(problem), **COLD_VARIANTS[name])
+        try:
+            start = time.perf_counter()
+            cold = solver.solve(problem.scaled_pbar(pstar=0.5), RTOL)
+            cold_seconds = time.perf_counter() - start
+            cold_pairs = cold.pairs
+            previous, pairs, converged, starts = [], [], 0, []
+            start = time.perf_counter()
+            for pstar in loads:
+                pbar = problem.scaled_pbar(pstar=pstar)
+                if previous:
+                    p0, u0 = extrapolated_start(previous, loads, pbar)
+                    result = solver.solve(pbar, RTOL, start=p0, start_displacement=u0)
+                    starts.append(result.levels[-1].history[0])
+                else:
+                    result = solver.solve(pbar, RTOL)
+                pairs.append(result.pairs)
+                converged += result.converged
+                # K p of the solution: the certificate's fresh gap plus h less d (no extra pair).
+                displacement = solver.last_displacement.copy()
+                previous = (previous + [(pbar, result.pressure.copy(), displacement)])[-2:]
+            seconds = time.perf_counter() - start
+        finally:
+            solver.destroy()
+    warm = np.mean(pairs[1:])
+    add_row(rows, path, dict(part="warm", key=key, variant=name, steps=len(loads), cold_pairs=float(cold_pairs),
+                             warm_pairs=float(warm), ratio=float(warm / cold_pairs),
+                             time_ratio=float(seconds / len(loads) / cold_seconds), converged=int(converged),
+                             start_residual=float(np.median(starts))))
+
+
+# --- report -----------------------------------------------------------------------------------------------
+def rows_of(rows, part):
+    return [r for r in rows if r["part"] == part]
+
+
+def lookup(rows, part, key, variant, field="pairs"):
+    found = [r for r in rows if r["part"] == part and r["key"] == key and r["variant"] == variant]
+    return found[-1][field] if found else None
+
+
+def fmt(value, spec=".0f"):
+    return "-" if value is None else format(value, spec)
+
+
+def floor_table(rows, keys, floor_names):
+    header = ["group", "p*", "N", "|C|/N^2"] + [f"{n} pairs" for n in floor_names] + \
+             [f"{n} lambda_min / lambda_max (cond)" for n in floor_names]
+    table = []
+    for key in keys:
+        group, n, pstar = parse_key(key)
+        floor = {name: [r for r in rows_of(rows, "floor") if r["key"] == key and r["variant"] == name]
+                 for name in floor_names}
+        if not any(floor.values()):
+            continue
+        first = next(v[-1] for v in floor.values() if v)
+        row = [group, f"{pstar:g}", n, f"{first['contact'] / n ** 2:.3f}"]
+        row += [fmt(v[-1]["pairs"], "d") if v else "-" for v in floor.values()]
+        row += [f"{v[-1]['lambda_min']:.3f} / {v[-1]['lambda_max']:.2f} ({v[-1]['cond']:.2f})" if v else "-"
+                for v in floor.values()]
+        table.append(row)
+    return common.markdown_table(header, table)
+
+
+def slepc_table(rows):
+    check = []
+    for r in rows_of(rows, "slepc"):
+        lanczos = [f for f in rows_of(rows, "floor") if f["key"] == r["key"] and f["variant"] == r["variant"]]
+        lz = lanczos[-1] if lanczos else None
+        check.append([r["key"], r["variant"], f"{r['lambda_min']:.4f}", f"{r['lambda_max']:.4f}", f"{r['cond']:.3f}",
+                      f"{lz['lambda_min']:.4f}" if lz else "-", f"{lz['lambda_max']:.4f}" if lz else "-",
+                      f"{lz['cond']:.3f}" if lz else "-"])
+    return common.markdown_table(["case", "preconditioner", "SLEPc lambda_min", "SLEPc lambda_max", "SLEPc cond",
+                                  "Lanczos lambda_min", "Lanczos lambda_max", "Lanczos cond"], check)
+
+
+def cold_table(rows, keys, cold_names):
+    header = ["group", "p*", "N", "floor (fourier)", "floor (band2)", "pk (today)"] + cold_names + ["certified"]
+    table = []
+    for key in keys:
+        group, n, pstar = parse_key(key)
+        floor = lookup(rows, "floor", key, "fourier")
+        pk = lookup(rows, "pk", key, "pk")
+        if pk is None and not any(lookup(rows, "cold", key, c) for c in cold_names):
+            continue
+
+        def cell(value):
+            if value is None:
+                return "-"
+            return f"{value:.1f}" + (f" ({value / floor:.2f})" if floor else "")
+        cold = [r for r in rows_of(rows, "cold") if r["key"] == key]
+        certified = f"{sum(r['converged'] for r in cold)}/{len(cold)}" if cold else "-"
+        table.append([group, f"{pstar:g}", n, fmt(floor, "d"), fmt(lookup(rows, "floor", key, "band2"), "d"),
+                      cell(pk)] + [cell(lookup(rows, "cold", key, c)) for c in cold_names] + [certified])
+    return common.markdown_table(header, table)
+
+
+def timing_table(rows, keys, cold_names):
+    timing = []
+    for key in keys:
+        pk_seconds = lookup(rows, "pk", key, "pk", "seconds")
+        if pk_seconds is None:
+            continue
+        cells = []
+        for name in cold_names:
+            seconds = lookup(rows, "cold", key, name, "seconds")
+            cells.append(fmt(seconds / pk_seconds, ".2f") if seconds else "-")
+        timing.append([key] + cells)
+    return common.markdown_table(["case"] + cold_names, timing)
+
+
+def exact_band_table(rows):
+    exact = sorted(rows_of(rows, "exactband"), key=lambda r: (parse_key(r["key"])[1], int(r["variant"].split()[1])))
+    return common.markdown_table(["case", "band", "lambda_min", "lambda_max", "cond", "outer pairs", "inner pairs"],
+                                 [[r["key"], r["variant"], f"{r['lambda_min']:.3f}", f"{r['lambda_max']:.3f}",
+                                   f"{r['cond']:.2f}", r["pairs"], r["inner_pairs"]] for r in exact])
+
+
+def gaps_table(rows, keys):
+    table = []
+    for key in keys:
+        found = [r for r in rows_of(rows, "gaps") if r["key"] == key]
+        if found:
+            group, n, pstar = parse_key(key)
+            table.append([group, f"{pstar:g}", n, f"{found[-1]['median']:.0f}", f"{found[-1]['p90']:.0f}",
+                          f"{found[-1]['max']:.0f}"])
+    return common.markdown_table(["group", "p*", "N", "median", "90 %", "max"], table)
+
+
+def warm_table(rows):
+    return common.markdown_table(
+        ["case", "solver", "steps", "cold pairs (p* = 0.5)", "pairs per warm step", "ratio to its own cold",
+         "time ratio (noisy)", "median start residual", "certified"],
+        [[r["key"], r["variant"], r["steps"], f"{r['cold_pairs']:.1f}", f"{r['warm_pairs']:.1f}", f"{r['ratio']:.3f}",
+          f"{r['time_ratio']:.3f}", f"{r['start_residual']:.1e}" if "start_residual" in r else "-",
+          f"{r['converged']}/{r['steps']}"] for r in rows_of(rows, "warm")])
+
+
+def report(rows):
+    keys = sorted({r["key"] for r in rows}, key=lambda k: (parse_key(k)[0], parse_key(k)[2], parse_key(k)[1]))
+    floor_names = [n for n in PRECONDITIONERS if any(r["variant"] == n for r in rows_of(rows, "floor"))]
+    cold_names = [n for n in COLD_VARIANTS if any(r["variant"] == n for r in rows_of(rows, "cold"))]
+    lines = ["# The contact solver's floor, cold solves against it, and warm load steps (issue 39, items 1-4)", "",
+             "Written by `studies/solver_scaling.py` from its `rows*.json` (its docstring defines every quantity; "
+             "`studies/pk_cascade.py` describes the prototype solver step by step). FFT pairs and "
+             "iterations are deterministic; seconds come from one run each on a shared 2-core machine under a "
+             "load average of 5-11 (noisy: compare only as ratios, and loosely). Surfaces: `options/group01.opts` "
+             "(H = 0.8) and `options/group18.opts` (H = 0.1) at N x N, seed 1; natural KKT residual 1e-8.", "",
+             "Preconditioners: `fourier` = the Fourier preconditioner of today's solver; `band<k>` = the edge-band "
+             "preconditioner `pk_cascade.BandPC` (`-lu`: its band matrix solved exactly, a diagnostic); "
+             "`schur<k>` = `pk_cascade.SchurPC` (two pairs per application): "
+             + "; ".join(f"`{k}` = `{v}`" for k, v in PRECONDITIONERS.items() if k != "fourier") + ".", "",
+             "## 1. The floor: preconditioned CG on the exact final contact set", "",
+             "Pairs to a certified natural residual of 1e-8 from the uniform pressure on C (2 k + 2 for k "
+             "iterations); cond = lambda_max / lambda_min of the preconditioned operator on the zero-sum "
+             "subspace of C, from the Lanczos matrix of the CG coefficients (CG run on to a reduction of "
+             "1e-10; Ritz values lie inside the spectrum, so lambda_max is a lower and lambda_min an upper "
+             "estimate).", "", floor_table(rows, keys, [n for n in floor_names if n in MAIN_PRECONDITIONERS]), ""]
+    if rows_of(rows, "slepc"):
+        lines += ["SLEPc cross-check (Krylov-Schur, tolerance 1e-8, the constant on C deflated):", "",
+                  slepc_table(rows), ""]
+    lines += ["## 2. Cold solves against the floor", "",
+              "FFT pairs of a cold solve to a certified natural residual of 1e-8 (coarse levels weighted by "
+              "(N_c/N)^2, the certificate included); in brackets the ratio to the Fourier floor of section 1. "
+              "`pk (today)`: the default solver (`python -m roughpetsc -options_file options/groupNN.opts "
+              "-surface_N N -pstar P`). The variants are `COLD_VARIANTS` of the study; `best` is the candidate "
+              "described in `pk_cascade.py`. `certified`: the cold variants of the case whose result passed "
+              "an independent certificate (`ContactProblem.gap`, `kkt.report`).", "",
+              cold_table(rows, keys, cold_names), "",
+              "Wall time of each cold solve over today's `pk` on the same case (one run each; `pk` includes its "
+              "solver set-up, the variants do not include their grids' FFTW planning; noisy):", "",
+              timing_table(rows, keys, cold_names), ""]
+    lines += ["## 3. The edge-band preconditioner and its exact limit", "",
+              "The `band<k>` floor columns of section 1 are the practical edge-band preconditioner. Other "
+              "settings, the band's near-field matrix solved exactly (`-lu`), and the Schur form with the "
+              "coupling by FFT (`schur<k>`, two pairs per application, counted) on the same floor problem:", "",
+              floor_table(rows, keys, [n for n in floor_names if n not in MAIN_PRECONDITIONERS]), "",
+              "How far the nodes outside C lie from C (Chebyshev distance in nodes; `gaps` part):", "",
+              gaps_table(rows, keys), "",
+              "The limit with an exact band solve (`ExactBandPC` of the study: S_OO^-1 by an inner CG, the "
+              "coupling by FFT, a diagnostic only: its inner pairs are counted apart) against the band width:",
+              ""]
+    lines += [exact_band_table(rows) if rows_of(rows, "exactband") else "(not run)", ""]
+    lines += ["## 4. Warm steps along the load history (7.11)", ""]
+    lines += [warm_table(rows) if rows_of(rows, "warm") else "(not run)", ""]
+    plot(rows, keys, floor_names, cold_names)
+    lines += ["![floor and cold solves](solver_scaling.png)", "",
+              "Regenerate (resumable; `--report` rewrites this file from the rows): see the module docstring of "
+              "`studies/solver_scaling.py`.", ""]
+    return "\n".join(lines)
+
+
+def plot(rows, keys, floor_names, cold_names):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cases = sorted({(parse_key(k)[0], parse_key(k)[2]) for k in keys})
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    for index, (group, pstar) in enumerate(cases):
+        color = f"C{index % 10}"
+        sizes = sorted(parse_key(k)[1] for k in keys if parse_key(k)[0] == group and parse_key(k)[2] == pstar)
+
+        def series(part, variant, field):
+            values = [lookup(rows, part, case_key(group, n, pstar), variant, field) for n in sizes]
+            return [n for n, v in zip(sizes, values) if v], [v for v in values if v]
+        label = f"g{group} p*={pstar:g}"
+        axes[0].semilogx(*series("floor", "fourier", "pairs"), "o-", color=color, label=f"floor {label}")
+        axes[0].semilogx(*series("pk", "pk", "pairs"), "s--", color=color, alpha=0.6)
+        best = "best" if "best" in cold_names else (cold_names[0] if cold_names else None)
+        if best:
+            axes[0].semilogx(*series("cold", best, "pairs"), "^:", color=color, alpha=0.8)
+        for style, name in zip(("o-", "d:"), [n for n in floor_names if n in ("fourier", "band2")]):
+            axes[1].semilogx(*series("floor", name, "cond"), style, color=color,
+                             label=f"{name} {label}" if name == "fourier" else None)
+    axes[0].set_xlabel("N")
+    axes[0].set_ylabel("FFT pairs to natural KKT 1e-8")
+    axes[0].set_title("Fourier floor (o-), today's PK (s--), best (^:)")
+    axes[1].set_xlabel("N")
+    axes[1].set_ylabel("cond of the preconditioned operator on C")
+    axes[1].set_title("Fourier (o-) and edge-band band2 (d:) preconditioners")
+    for axis in axes:
+        axis.grid(alpha=0.3, which="both")
+    axes[0].legend(fontsize=7, ncol=2)
+    common.save_figure(fig, OUT, "solver_scaling.png")
+
+
+# --- main -------------------------------------------------------------------------------------------------
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--sizes", type=int, nargs="*", default=[256, 512, 1024, 2048])
+    parser.add_argument("--loads", type=float, nargs="*", default=[0.05, 0.5, 2.0])
+    parser.add_argument("--groups", type=int, nargs="*", default=[1, 18])
+    parser.add_argument("--parts", nargs="*", default=["reference", "pk", "floor", "cold"],
+                        choices=["reference", "pk", "floor", "cold", "slepc", "warm", "exactband", "gaps"])
+    parser.add_argument("--widths", type=int, nargs="*", default=[1, 2, 4, 8],
+                        help="band widths of the exactband diagnostic")
+    parser.add_argument("--floor-pcs", nargs="*", default=["fourier", "band2"], choices=list(PRECONDITIONERS))
+    parser.add_argument("--cold", nargs="*", default=["pcg", "cascade", "band2", "cascade-band2"],
+                        choices=list(COLD_VARIANTS))
+    parser.add_argument("--warm", nargs="*", default=["pk", "cascade-band2"], choices=["pk"] + list(COLD_VARIANTS))
+    parser.add_argument("--warm-n", type=int, default=1024, help="grid of the warm-step part (at p* = 0.5)")
+    parser.add_argument("--cache", default=os.path.expanduser("~/.cache/roughpetsc/solver_scaling"),
+                        help="folder of the reference contact sets (bit masks)")
+    parser.add_argument("--rows", default="rows", help="the rows file (OUT/NAME.json) this run adds to, so that "
+                                                         "two runs can go side by side; the report reads every "
+                                                         "rows*.json")
+    args, _, _ = common.start_resumable(parser, OUT, "rows", "write report.md from the saved rows only")
+    path = os.path.join(OUT, args.rows + ".json")
+    rows = common.load_rows(path)
+    if not args.report:
+        for group in args.groups:
+            for n in args.sizes:
+                for pstar in args.loads:
+                    run_case(args, group, n, pstar, rows, path)
+    every = [row for name in sorted(os.listdir(OUT)) if name.startswith("rows") and name.endswith(".json")
+             for row in common.load_rows(os.path.join(OUT, name))]
+    with open(os.path.join(OUT, "report.md"), "w") as f:
+        f.write(report(every))
+
+
+def run_case(args, group, n, pstar, rows, path):
+    key = case_key(group, n, pstar)
+    todo = {part for part in args.parts if part not in ("floor", "cold", "slepc", "warm")
+            and not has_row(rows, part, key, "pk" if part == "pk" else "pk 1e-12")}
+    floors = [name for name in args.floor_pcs if "floor" in args.parts and not has_row(rows, "floor", key, name)]
+    colds = [name for name in args.cold if "cold" in args.parts and not has_row(rows, "cold", key, name)]
+    slepcs = [name for name in args.floor_pcs if "slepc" in args.parts and not has_row(rows, "slepc", key, name)]
+    warms = [name for name in args.warm if "warm" in args.parts and n == args.warm_n and pstar == 0.5
+             and not has_row(rows, "warm", key, name)]
+    widths = [w for w in args.widths if "exactband" in args.parts and not has_row(rows, "exactband", key, f"width {w}")]
+    gaps = "gaps" in args.parts and not has_row(rows, "gaps", key, "distance to C")
+    if not (todo or floors or colds or slepcs or warms or widths or gaps):
+        return
+    print(f"--- {key}", flush=True)
+    problem = make_problem(group, n)
+    try:
+        if "pk" in todo:
+            run_pk(problem, pstar, key, rows, path)
+        if floors or slepcs or widths or gaps or "reference" in todo:
+            contact = reference_contact(problem, pstar, args.cache, key, rows, path)
+        for name in floors:
+            run_floor(problem, pstar, contact, key, name, rows, path)
+        if gaps:
+            run_gaps(problem, contact, key, rows, path)
+        for width in widths:
+            run_exact_band(problem, pstar, contact, key, width, rows, path)
+        for name in slepcs:
+            run_slepc(problem, pstar, contact, key, name, rows, path)
+        for name in colds:
+            run_cold(problem, pstar, key, name, rows, path)
+        for name in warms:
+            run_warm(problem, key, name, rows, path)
+    finally:
+        problem.destroy()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
