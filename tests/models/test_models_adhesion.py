@@ -267,7 +267,7 @@ def test_model_curves_at_one_twentieth_are_single_valued():
     """The model is a function of p*: at sigma0/E* = 1/20, on the moments of the group #1 surface of the 512^2
     study (seed 1), 1 - A* and g* fall strictly along loading and along unloading from p*max = 2 on a fine p*
     grid. (The jagged, folded model curves once drawn in studies/output/adhesion/chapter6.png came from
-    plotting it in the BEM's step order; the BEM's p*(g*) folds for real, see test_adhesion.py.)"""
+    plotting it in the BEM's step order; the BEM's p*(g*) folds for real, see tests/contact/test_adhesion.py.)"""
     moments = (1.2047024726831547e-08, 2.0064674091124703e-04, 9.146583723919058, 693876.6925952481)
     model = M.AdhesiveGW(*moments, 1 / 20, 0.33 * np.sqrt(moments[0]))
     p = np.linspace(0.5, 2.0, 31)
