@@ -13,10 +13,11 @@
 # 1/20 (167 steps, not let go at g* = 10.7) 0.09. The first 2048^2 solve of the path took 708 operator
 # applications and 349 s: a 2048^2 cycle would take about 1 core-hour, out of reach for ten surfaces here.
 #   n512        : 512^2, 10 surfaces, sigma0/E* = 1/100, 1/50, 1/20 (partial cycles)
-#   n1024_r100  : 1024^2, the same 10 surfaces at 1/100 (the best resolved cohesive zone)
+#   n1024_r100_a: 1024^2, surfaces 1-5 at 1/100 (the best resolved cohesive zone)
 #   n1024_r50_20: 1024^2, surfaces 1-3 at 1/50 and 1/20 (the grid sequence where the zone is narrower)
 #   full_512    : 512^2, full cycles (retraction until the contact lets go) at 1/100 and 1/50, 10 surfaces:
-#                 the pull-off at 1/100 lies beyond g* = 0.6
+#                 their pull-off lies beyond g* = 0.6
+#   n1024_r100_b: 1024^2, surfaces 6-10 at 1/100
 #   n1024_rest  : 1024^2, surfaces 4-10 at 1/50 and 1/20
 set -u
 cd "$(dirname "$0")/.."
@@ -26,14 +27,15 @@ ALL="1 2 3 4 5 6 7 8 9 10"
 stage() {
   case "$1" in
     n512) run --sizes 512 --ratios 100 50 20 --seeds $ALL ;;
-    n1024_r100) run --sizes 1024 --ratios 100 --seeds $ALL ;;
+    n1024_r100_a) run --sizes 1024 --ratios 100 --seeds 1 2 3 4 5 ;;
+    n1024_r100_b) run --sizes 1024 --ratios 100 --seeds 6 7 8 9 10 ;;
     n1024_r50_20) run --sizes 1024 --ratios 50 20 --seeds 1 2 3 ;;
     full_512) run --protocol full --sizes 512 --ratios 100 50 --seeds $ALL ;;
     n1024_rest) run --sizes 1024 --ratios 50 20 --seeds 4 5 6 7 8 9 10 ;;
     *) echo "unknown stage $1" >&2; return 2 ;;
   esac
 }
-for s in ${@:-n512 n1024_r100 n1024_r50_20 full_512 n1024_rest}; do
+for s in ${@:-n512 n1024_r100_a n1024_r50_20 full_512 n1024_r100_b n1024_rest}; do
   echo "=== stage $s: $(date)"
   stage "$s"
 done
