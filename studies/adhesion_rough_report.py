@@ -4,7 +4,11 @@ hysteresis (issue 36, item 4 (c)-(d)).
     .venv/bin/python studies/adhesion_rough_cycles.py --report
 
 Reads every case file of studies/output/adhesion/rough/ and writes studies/output/adhesion/rough_cycles.md with
-rough_cycles_paths.png, rough_cycles_grid.png and rough_cycles_energy.png.
+rough_cycles_paths.png and rough_cycles_grid.png. The report opens with the campaign's status: the cells of the
+plan of studies/adhesion_rough_runs.sh (``PLAN`` here) that have case files, the case a checkpoint holds, the
+command that resumes the rest and its cost estimated from the CPU times the case files record; a campaign that is
+not complete is called partial there, and the reading of the model's errors is stated as provisional on the
+counts of surfaces and grids behind it.
 
 Definitions (g* = gbar / sqrt(m0^h), p* = pbar / sqrt(m0^p), both exact on every grid: the moments of a
 band-limited surface do not depend on N):
@@ -35,6 +39,15 @@ import common
 from adhesion_rough_cycles import OUT, read_rows
 
 REPORT = os.path.join(common.OUTPUT, "adhesion", "rough_cycles.md")
+RESUME = "bash studies/adhesion_rough_runs.sh > rough_runs.log 2>&1 &"
+SEEDS = tuple(range(1, 11))
+# The campaign of studies/adhesion_rough_runs.sh, stage by stage in its order: (stage, protocol, N, ratios, seeds).
+PLAN = (("n512", "partial", 512, (100, 50, 20), SEEDS),
+        ("n1024_r100_a", "partial", 1024, (100,), (1, 2, 3, 4, 5)),
+        ("n1024_r50_20", "partial", 1024, (50, 20), (1, 2, 3)),
+        ("full_512", "full", 512, (100, 50), SEEDS),
+        ("n1024_r100_b", "partial", 1024, (100,), (6, 7, 8, 9, 10)),
+        ("n1024_rest", "partial", 1024, (50, 20), (4, 5, 6, 7, 8, 9, 10)))
 PSTARS = (0.5, 1.0, 1.5, 2.0)
 UNLOAD_PSTARS = (1.5, 1.0, 0.5)
 P_LO = 0.5
@@ -168,8 +181,9 @@ def states_at_p(case, target, stage):
     return first_passage(g, p, [a, nodes.astype(float)], target, stage > 0)
 
 
-def model_errors(grouped, ratio, n):
-    """Rows (stage, p*): BEM and model means and the relative errors of 1 - A* and g*."""
+def model_errors(grouped, ratio, n, numbers=None):
+    """Rows (stage, p*): BEM and model means and the relative errors of 1 - A* and g*. ``numbers``, if given,
+    receives {(stage, p*): (mean rel. error 1 - A*, mean rel. error g*, surfaces)}."""
     rows = []
     cases = grouped[(ratio, n)]
     models = {c.seed: c.model() for c in cases}
@@ -195,6 +209,8 @@ def model_errors(grouped, ratio, n):
                 continue
             b = np.array(bem)
             ea, eg = mean_sd_se(err_a), mean_sd_se(err_g)
+            if numbers is not None:
+                numbers[(stage, target)] = (ea[0], eg[0], len(bem))
             rows.append(["approach" if stage > 0 else "retraction", f"{target:g}", len(bem), f"{np.mean(nodes):.0f}",
                          fmt(b[:, 1].mean()), fmt(np.mean(model_a)), fmt(ea[0], ea[1], 2),
                          fmt(b[:, 0].mean()), fmt(np.mean(model_g)), fmt(eg[0], eg[1], 2),
@@ -290,6 +306,185 @@ def core_hours(cases):
             for (protocol, n), (hours, count, steps, apps) in sorted(out.items())]
 
 
+def checkpoints():
+    """(name, rows, turn, CPU seconds) of every checkpoint: the cases a run was inside when it stopped."""
+    from adhesion_rough_cycles import CHECKPOINTS
+
+    out = []
+    for path in sorted(glob.glob(os.path.join(CHECKPOINTS, "*.h5"))):
+        rows, attrs, _ = read_rows(path)
+        out.append((os.path.basename(path)[:-3], len(rows), int(attrs["turn"]), float(attrs["cpu_seconds"])))
+    return out
+
+
+def cost_per_case(cases):
+    """({(protocol, N, ratio): (core-hours per case, how)}, the 1024^2 / 512^2 cost factor).
+
+    Measured where a cell has case files. A missing 1024^2 cell: its 512^2 cost times the mean 1024^2 / 512^2
+    ratio of the surfaces run on both grids (at any sigma0); a missing full-protocol cell: its partial cost times
+    the mean full / partial ratio of the surfaces run both ways."""
+    hours = {}
+    for c in cases:
+        hours.setdefault((c.protocol, c.n, c.ratio), {})[c.seed] = float(c.attrs["cpu_seconds"]) / 3600
+
+    def factor(pairs):
+        values = [hours[key][seed] / hours[base][seed] for key, base in pairs if key in hours and base in hours
+                  for seed in hours[key] if seed in hours[base]]
+        return float(np.mean(values)) if values else float("nan")
+
+    grid = factor([(k, ("partial", 512, k[2])) for k in hours if k[:2] == ("partial", 1024)])
+    full = factor([(k, ("partial", k[1], k[2])) for k in hours if k[0] == "full"])
+    out = {key: (float(np.mean(list(v.values()))), "measured") for key, v in hours.items()}
+    for _, protocol, n, ratios, _ in PLAN:
+        for ratio in ratios:
+            key = (protocol, n, float(ratio))
+            if key in out:
+                continue
+            base = out.get(("partial", 512, float(ratio)), (float("nan"),))[0]
+            if protocol == "partial" and n == 1024:
+                out[key] = (base * grid, f"scaled: 512^2 x {grid:.1f}")
+            elif protocol == "full" and n == 512:
+                out[key] = (base * full, f"scaled: partial x {full:.1f}")
+    return out, grid
+
+
+def status(cases):
+    """The campaign's status: lines of markdown, and the headline counts {(protocol, N, ratio): seeds}."""
+    have = {}
+    for c in cases:
+        have.setdefault((c.protocol, c.n, c.ratio), set()).add(c.seed)
+    held = checkpoints()
+    costs, grid_factor = cost_per_case(cases)
+    planned = sum(len(ratios) * len(seeds) for _, _, _, ratios, seeds in PLAN)
+    done = sum(len(have.get((protocol, n, float(r)), set()) & set(seeds))
+               for _, protocol, n, ratios, seeds in PLAN for r in ratios)
+    rows, total = [], 0.0
+    for stage, protocol, n, ratios, seeds in PLAN:
+        for ratio in ratios:
+            key = (protocol, n, float(ratio))
+            present = sorted(have.get(key, set()) & set(seeds))
+            missing = [s for s in seeds if s not in present]
+            per_case, how = costs.get(key, (float("nan"), "-"))
+            remaining = per_case * len(missing)
+            held_here = [h for h in held if f"_n{n}_" in h[0] and f"_r{ratio:g}_" in h[0] and h[0].endswith(protocol)]
+            if held_here:
+                remaining -= sum(h[3] for h in held_here) / 3600
+            total += remaining if np.isfinite(remaining) else 0.0
+            rows.append([stage, protocol, f"{n}^2", f"1/{ratio:g}", seed_list(present) or "none",
+                         (seed_list(missing) or "none")
+                         + "".join(f" (surface {int(h[0].split('_s')[1][:2])}: checkpoint at step {h[1]})"
+                                   for h in held_here),
+                         f"{per_case:.3f} ({how})" if np.isfinite(per_case) else "-",
+                         f"{remaining:.2f}" if np.isfinite(remaining) else "-"])
+    extra = sorted(k for k in have if not any(k == (protocol, n, float(r)) for _, protocol, n, ratios, _ in PLAN
+                                               for r in ratios))
+    cpu = sum(float(c.attrs["cpu_seconds"]) for c in cases) / 3600
+    wall = sum(float(c.attrs["wall_seconds"]) for c in cases) / 3600
+    n1024 = {r: sorted(have.get(("partial", 1024, float(r)), set())) for r in (100, 50, 20)}
+    lines = ["## Status: a partial campaign", "",
+             f"**The campaign is partial: {done} of the {planned} planned cycles have case files.** The plan is "
+             "`studies/adhesion_rough_runs.sh` (group #1, p*max = 2: 512^2 and 1024^2, ten surfaces, sigma0/E* = "
+             "1/100, 1/50, 1/20, partial protocol; full cycles at 512^2, 1/100 and 1/50). What exists:", ""]
+    for (protocol, n, ratio), seeds in sorted(have.items(), key=lambda kv: (kv[0][0] != "partial", kv[0][1],
+                                                                          -kv[0][2])):
+        lines.append(f"- {protocol}, {n}^2, sigma0/E* = 1/{ratio:g}: {len(seeds)} surface"
+                     f"{'s' if len(seeds) != 1 else ''} ({seed_list(sorted(seeds))})"
+                     + (" (outside the plan)" if (protocol, n, ratio) in extra else ""))
+    lines += ["",
+              "So 1024^2 has "
+              + ("; ".join(f"{len(s)} surface{'s' if len(s) != 1 else ''} at 1/{r}" for r, s in n1024.items() if s)
+                 or "no surface")
+              + (" only" if sum(map(len, n1024.values())) == 1 else "")
+              + ("; " + " and ".join(f"1/{r}" for r, s in n1024.items() if not s) + " ha"
+                 + ("s" if sum(not s for s in n1024.values()) == 1 else "ve") + " no 1024^2 run, so no grid change "
+                 "is measured there" if not all(n1024.values()) else "")
+              + "; and there is **no 2048^2 run "
+              "at all** (a third grid, which would give the order of convergence, is not in the plan: about "
+              f"{costs.get(('partial', 1024, 100.0), (float('nan'),))[0] * grid_factor:.1f} core-hours a cycle at "
+              "1/100, the 1024^2 cost scaled by the same 512^2 -> 1024^2 factor)."
+              + "".join(f" A run stopped inside {h[0]} (checkpoint at step {h[1]}, {h[3] / 60:.1f} CPU minutes in, "
+                        "committed): the resume starts there." for h in held), "",
+              f"Resume (every stage skips finished cases and restarts an unfinished one from its checkpoint): `{RESUME}`"
+              ", or the named stages, e.g. `bash studies/adhesion_rough_runs.sh n1024_r100_a n1024_r50_20`.", "",
+              "Remaining cost, in core-hours of process CPU time per case as the case files record it (measured "
+              "where the cell has cases, else scaled as stated; the checkpoint's CPU time already spent is "
+              f"subtracted). So far {cpu:.2f} core-hours CPU in {wall:.2f} hours of wall time: the 2 cores are "
+              "shared, so the wall time is several times the CPU time.", "",
+              common.markdown_table(["stage", "protocol", "N", "sigma0/E*", "surfaces done", "missing",
+                                     "core-hours per case", "core-hours left"], rows), "",
+              f"Total left: about {total:.1f} core-hours of CPU time.", ""]
+    return lines, have
+
+
+def seed_list(seeds):
+    """'1-5, 7' for [1, 2, 3, 4, 5, 7]."""
+    parts, run = [], []
+    for s in list(seeds) + [None]:
+        if run and (s is None or s != run[-1] + 1):
+            parts.append(f"{run[0]}-{run[-1]}" if len(run) > 2 else ", ".join(map(str, run)))
+            run = []
+        if s is not None:
+            run.append(s)
+    return ", ".join(parts)
+
+
+def provisional_reading(numbers, have, energy, grouped):
+    """Markdown lines: the model's errors at p* = 1 and 2 of the approach, per cell, with the counts behind them."""
+    lines = ["## Provisional reading of the adhesive GW model on these surfaces", "",
+             "**Provisional, on the counts above.** Wherever no finer grid exists the model's error below is mixed "
+             "with the BEM's discretisation error, and a cell of one surface has no spread. Mean relative error "
+             "(model - BEM) / BEM at the approach's first passage through p* (from the tables below):", ""]
+    rows = []
+    for (ratio, n), values in sorted(numbers.items(), key=lambda kv: (-kv[0][0], kv[0][1])):
+        row = [f"1/{ratio:g}", f"{n}^2", values.get((1, 1.0), (0, 0, 0))[2]]
+        for target in (1.0, 2.0):
+            a, g, _ = values.get((1, target), (float("nan"),) * 3)
+            row += [f"{a:+.2f}" if np.isfinite(a) else "-", f"{g:+.2f}" if np.isfinite(g) else "-"]
+        rows.append(row)
+    lines += [common.markdown_table(["sigma0/E*", "N", "surfaces", "1-A* at p* = 1", "g* at p* = 1",
+                                     "1-A* at p* = 2", "g* at p* = 2"], rows), ""]
+
+    def says(error):
+        if not np.isfinite(error):
+            return "-"
+        return f"is within {abs(error):.0%}" if abs(error) < 0.1 else \
+            f"{'over' if error > 0 else 'under'}estimates by {abs(error):.0%}"
+
+    for ratio in sorted({r for r, _ in numbers}, reverse=True):
+        finest = max(n for r, n in numbers if r == ratio)
+        values = numbers[(ratio, finest)]
+        count = values.get((1, 1.0), (0, 0, 0))[2]
+        parts = []
+        for target in (1.0, 2.0):
+            a, g, _ = values.get((1, target), (float("nan"),) * 3)
+            parts.append(f"at p* = {target:g} the model {says(a)} (1 - A*) and {says(g)} (g*)")
+        grid_note = ("no finer grid than 512^2: this is the model's error and the BEM's together"
+                     + (", and the cohesive zone is narrowest here" if ratio == 20 else "")) if finest == 512 else \
+            (f"{count} surface{'s' if count != 1 else ''} at {finest}^2, against "
+             f"{numbers.get((ratio, 512), {}).get((1, 1.0), (0, 0, 0))[2]} at 512^2; the values are the "
+             f"{finest}^2 ones")
+        lines.append(f"- 1/{ratio:g} ({grid_note}): " + "; ".join(parts) + ".")
+    for ratio in sorted({r for r, _ in energy}, reverse=True):
+        cells = sorted(n for r, n in energy if r == ratio)
+        parts = [f"BEM {energy[(ratio, n)][2][0]:.3g} on {energy[(ratio, n)][2][3]} surface"
+                 f"{'s' if energy[(ratio, n)][2][3] != 1 else ''} at {n}^2, model {energy[(ratio, n)][3][0]:.3g}"
+                 for n in cells]
+        if len(cells) > 1:
+            pairs = [(c, f) for c in grouped[(ratio, cells[-2])] for f in grouped[(ratio, cells[-1])]
+                     if c.seed == f.seed]
+            changes = [(loop_area(f, P_LO) - loop_area(c, P_LO)) / loop_area(c, P_LO) for c, f in pairs
+                       if loop_area(c, P_LO) and loop_area(f, P_LO) is not None]
+            if changes:
+                parts.append(f"the BEM loop area of the {len(changes)} surface{'s' if len(changes) != 1 else ''} "
+                             f"run on both grids changed by {np.mean(changes):+.0%} from {cells[-2]}^2 to "
+                             f"{cells[-1]}^2, so it is not converged")
+        lines.append(f"- Hysteresis at 1/{ratio:g} (loop area over p* >= {P_LO:g}): " + "; ".join(parts) + ".")
+    lines += ["- No statement here on the adhesive GW model at rough surfaces is final: it waits for the 1024^2 "
+              "cells to hold the ten surfaces at every ratio (the resume command above), and a convergence order "
+              "would need a third grid.", ""]
+    return lines
+
+
 def figures(grouped, full_cases):
     import matplotlib
 
@@ -360,6 +555,16 @@ def report(group=1, pmax=2.0):
              f"`rough/` (group #{group}, p*max = {pmax:g}; set-up, protocols and definitions in the docstrings of "
              "`studies/adhesion_rough_cycles.py` and `studies/adhesion_rough_report.py`). Surfaces per cell: "
              + ", ".join(f"1/{r:g} at N = {n}: {len(grouped[(r, n)])}" for r, n in grouped) + ".", ""]
+    status_lines, have = status(cases)
+    lines += status_lines
+    numbers = {}
+    for ratio in ratios:
+        for n in sizes:
+            if (ratio, n) in grouped:
+                numbers[(ratio, n)] = {}
+    error_rows = {key: model_errors(grouped, *key, numbers=numbers[key]) for key in numbers}
+    energy = {key: energies(grouped, *key) for key in grouped}
+    lines += provisional_reading(numbers, have, energy, grouped)
     lines += ["## Grid convergence at a fixed mean gap (approach)", "",
               "Mean over the surfaces every grid has (± standard error); the gaps are those of the path nearest the "
               "finest grid's first passage through p* = 0.5, 1, 1.5, 2. Changes are relative, from one grid to the "
@@ -380,7 +585,7 @@ def report(group=1, pmax=2.0):
         for n in sizes:
             if (ratio, n) not in grouped:
                 continue
-            rows = model_errors(grouped, ratio, n)
+            rows = error_rows[(ratio, n)]
             lines += [f"sigma0/E* = 1/{ratio:g}, N = {n}:", "",
                       common.markdown_table(["stage", "p*", "surfaces", "nodes", "BEM 1-A*", "model 1-A*",
                                              "rel. error 1-A*", "BEM g*", "model g*", "rel. error g*",
@@ -400,13 +605,26 @@ def report(group=1, pmax=2.0):
                     header += [f"{q} {sizes[-2]}", f"{q} {sizes[-1]}", f"{q} extrap.", "change", "model err",
                                "model err vs extrap."]
                 lines += [f"sigma0/E* = 1/{ratio:g}:", "", common.markdown_table(header, rows), ""]
+                pairs = [(c, f) for c in grouped[(ratio, sizes[-2])] for f in grouped[(ratio, sizes[-1])]
+                         if c.seed == f.seed]
+                rows = []
+                for c, f in pairs:
+                    pull = [float(np.min(x.part(-1)[1])) for x in (c, f)]
+                    area = [loop_area(x, P_LO) for x in (c, f)]
+                    rows.append([c.seed, f"{pull[0]:+.3f}", f"{pull[1]:+.3f}", fmt(area[0]), fmt(area[1]),
+                                 f"{(area[1] - area[0]) / area[0]:+.0%}" if None not in area and area[0] else "-"])
+                lines += [f"The same surfaces' least retraction p* (within g* <= 0.6) and loop area over p* >= "
+                          f"{P_LO:g} on both grids (1/{ratio:g}):", "",
+                          common.markdown_table(["surface", f"least p* {sizes[-2]}", f"least p* {sizes[-1]}",
+                                                 f"loop area {sizes[-2]}", f"loop area {sizes[-1]}", "change"],
+                                                rows), ""]
     lines += ["## Pull-off and hysteresis", "",
               f"Pull-off: least p* of the retraction (within g* <= 0.6). Hysteresis: loop area int g* dp* over p* >= "
               f"{P_LO:g} (BEM) against `AdhesiveGW.dissipated_energy(p*max, {P_LO:g})` at the p*max each path "
               "turned at (Maugis-Dugdale and JKR limit). Mean ± sd (standard error in brackets).", ""]
     rows = []
     for (ratio, n) in grouped:
-        (pm, psd, pse, pc), edge, (am, asd, ase, ac), (mm, _, _, _), (jm, _, _, _) = energies(grouped, ratio, n)
+        (pm, psd, pse, pc), edge, (am, asd, ase, ac), (mm, _, _, _), (jm, _, _, _) = energy[(ratio, n)]
         rows.append([f"1/{ratio:g}", n, pc, f"{pm:+.3f} ± {psd:.3f} ({pse:.3f})", edge,
                      f"{am:.3g} ± {asd:.2g} ({ase:.2g})", f"{mm:.3g}", f"{jm:.3g}",
                      f"{(mm - am) / am:+.0%}" if am else "-"])

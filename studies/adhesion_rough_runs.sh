@@ -2,10 +2,11 @@
 # The adhesive BEM cycles behind studies/output/adhesion/rough_cycles.md (issue 36, item 4 (c)-(d)), in order of
 # priority, one niced process at a time. Every stage is resumable (studies/adhesion_rough_cycles.py: a case file
 # per finished cycle, a checkpoint inside an unfinished one): rerun this script, or the stages named, after a kill.
-# The case files (~20 kB) are tracked by git; the checkpoints are not.
+# The case files (~20 kB) are tracked by git; the checkpoints are not (except the one the partial campaign stopped
+# in, committed with it, so that the first stage resumes there).
 #
 #   bash studies/adhesion_rough_runs.sh > rough_runs.log 2>&1 &     # all stages
-#   bash studies/adhesion_rough_runs.sh n1024_r100                   # only the named stages
+#   bash studies/adhesion_rough_runs.sh n1024_r100_a n1024_r50_20     # only the named stages
 #
 # Measured (group #1, process CPU time, under a load of 10-14 on the 2 shared cores, where one process got
 # 10-33 % of a core): a partial cycle (approach from out of contact to p* = 2 and back to g* = 0.6, ~90 steps)
