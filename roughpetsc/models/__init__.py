@@ -20,7 +20,7 @@ curvefit_area(pstar, alpha_p, b, c, d, model="gw"), fit_curvefit(pstar, A, alpha
     with the PDF (2.42), the one that reproduces Table 8.4 (``curvefit_reference``; erratum of section 8.5).
 hertz, crack
     Hertz elliptical contact (4.6)-(4.17); pressurised elliptical/penny crack (5.15)-(5.32).
-AdhesiveCrack(sigma0), AdhesiveGW(...), jkr_*
+AdhesiveCrack(sigma0), JKRCrack(), AdhesiveGW(..., crack_law), jkr_*
     Penny-shaped adhesive crack (6.1)-(6.39) and adhesive adapted GW (6.40)-(6.54).
 sphere_adhesion, wavy_adhesion
     Closed forms that validate the adhesive BEM: a sphere (JKR, DMT, Maugis-Dugdale) and Johnson's wavy
@@ -28,7 +28,7 @@ sphere_adhesion, wavy_adhesion
 """
 
 from . import crack, hertz, pdfs, quadrature, sphere_adhesion, wavy_adhesion
-from .adhesion import AdhesiveCrack, AdhesiveGW, jkr_G, jkr_pmin, jkr_pstar, jkr_radius, jkr_volume, nonadhesive_area, nonadhesive_radius, nonadhesive_volume
+from .adhesion import CRACK_LAWS, AdhesiveCrack, AdhesiveGW, JKRCrack, jkr_G, jkr_pmin, jkr_pstar, jkr_radius, jkr_volume, nonadhesive_area, nonadhesive_radius, nonadhesive_volume
 from .complete import COMPLETE_MODELS, complete
 from .curvefit import ALPHA_P_TABLE_8_3, BGT_SLOPE, CURVEFIT_MODEL, TABLE_8_4, bootstrap_curvefit, correction, curvefit_area, curvefit_reference, curvefit_slope_at_zero, fit_curvefit
 from .early import EARLY_MODELS, TABLE_4_1, TABLE_4_1_SEPARATIONS, early, early_area, early_separation
@@ -38,6 +38,6 @@ __all__ = ["early", "early_area", "early_separation", "complete", "persson_area"
            "persson_gap", "psd_amplitude", "fractal_moments", "curvefit_area", "curvefit_reference",
            "curvefit_slope_at_zero", "CURVEFIT_MODEL", "fit_curvefit", "bootstrap_curvefit", "correction", "TABLE_8_4", "ALPHA_P_TABLE_8_3", "BGT_SLOPE",
            "EARLY_MODELS", "TABLE_4_1", "TABLE_4_1_SEPARATIONS", "COMPLETE_MODELS", "hertz", "crack", "pdfs", "quadrature",
-           "AdhesiveCrack", "AdhesiveGW", "jkr_pstar", "jkr_pmin", "jkr_radius",
+           "AdhesiveCrack", "AdhesiveGW", "JKRCrack", "CRACK_LAWS", "jkr_pstar", "jkr_pmin", "jkr_radius",
            "jkr_G", "jkr_volume", "nonadhesive_radius", "nonadhesive_area",
            "nonadhesive_volume"]

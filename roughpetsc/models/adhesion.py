@@ -19,6 +19,13 @@ Trapped volume: integrating the crack opening (6.24) over the crack gives
 V* = 2 pi b^3 [p - 9/10 b^2 - sigma0 (1 - m^2)^(3/2)] in closed form (the
 adhesive term is int_c^b 2 pi t sqrt(t^2 - c^2) dt); the printed (6.33)/(6.35)
 differ from it (see the study notes).
+
+JKR limit.  As sigma0 -> inf at a fixed surface energy w, sigma0* -> inf while the scales P, L of (6.4)
+stay, the cohesive zone vanishes (m -> 1), the stable branch tends to (6.14), the snap-in point B to
+(6.15), and E (6.38) and F (6.39) recede to infinity: a crack closed on loading never reopens
+(:class:`JKRCrack`).  ``AdhesiveGW(..., crack_law="jkr")`` is the rough model built on it, the model
+with loading-unloading hysteresis in the JKR limit that section 6.6 draws beside the Maugis-Dugdale one
+(Figs. 6.9-6.10, "calculated based on the work of Ciavarella et al.").
 """
 
 import numpy as np
@@ -29,7 +36,7 @@ from .quadrature import gauss_legendre, semi_infinite
 
 __all__ = ["jkr_pstar", "jkr_pmin", "jkr_radius", "jkr_G", "jkr_volume",
            "nonadhesive_radius", "nonadhesive_area", "nonadhesive_volume",
-           "AdhesiveCrack", "AdhesiveGW"]
+           "AdhesiveCrack", "JKRCrack", "AdhesiveGW", "CRACK_LAWS"]
 
 
 # --------------------------------------------------------------------- limits
@@ -93,6 +100,69 @@ def jkr_volume(b, p):
     return 2.0 * np.pi * b ** 3 * (p - 0.9 * b ** 2)
 
 
+class JKRCrack:
+    """Penny-shaped adhesive crack in the JKR limit, Eqs. (6.11)-(6.21), with its load history.
+
+    The limit sigma0* -> inf of :class:`AdhesiveCrack` at a fixed w (module docstring): the same
+    interface (``points``, ``breakpoints``, ``state``, ``area``, ``volume``), with m = c / b = 1 (no
+    cohesive zone) and ``sigma = inf``.
+
+    Attributes
+    ----------
+    points : dict
+        ``{"B": (p*_min, b*_min, 1)}``: the snap-in point (6.15), the only finite turning point.
+    """
+
+    sigma = np.inf
+
+    def __init__(self):
+        b_min = (np.sqrt(2.0) / 6.0) ** 0.4                                   # d p*/d b* = 0 in (6.14)
+        self.points = {"B": (float(jkr_pmin()), float(b_min), 1.0)}
+
+    def breakpoints(self):
+        """The p* at which the state of a crack changes with its history: B only."""
+        return [self.points["B"][0]]
+
+    def stable(self, p):
+        """b* on the stable branch (6.17) of (6.14) at p* >= p*_min (NaN below).
+
+        The larger root t of 3/2 t^5 - p t + sqrt 2 = 0 (t = sqrt b*, the footnote to (6.14)) by Newton's
+        method from t = (2 p / 3)^(1/4), where the polynomial is sqrt 2 > 0: it is convex for t > 0, so
+        the iterates decrease monotonically to the root (linearly only at p*_min, the double root).
+        """
+        p = np.atleast_1d(np.asarray(p, float))
+        ok = p >= self.points["B"][0]
+        pp = np.where(ok, p, self.points["B"][0])
+        t = (pp / 1.5) ** 0.25
+        for _ in range(200):
+            f = 1.5 * t ** 5 - pp * t + np.sqrt(2.0)
+            slope = 7.5 * t ** 4 - pp
+            step = np.where(f > 0, f / np.where(slope > 0, slope, np.inf), 0.0)
+            t = t - step
+            if np.all(step <= 1e-15 * t):
+                break
+        return np.where(ok, t * t, np.nan)
+
+    def state(self, p, p_min=None):
+        """Crack radius and m (= 1) after a load history; same conventions as :meth:`AdhesiveCrack.state`.
+
+        Loading (p* decreasing): the stable branch down to B, then closed. A crack that closed (history
+        minimum below p*_B) stays closed: its reopening point E (6.38) is at infinity.
+        """
+        p = np.atleast_1d(np.asarray(p, float))
+        pm = p if p_min is None else np.minimum(np.atleast_1d(np.asarray(p_min, float)), p)
+        b = np.where(pm >= self.points["B"][0], self.stable(np.maximum(p, self.points["B"][0])), 0.0)
+        return b, np.ones_like(b)
+
+    def area(self, b):
+        """A* = pi b*^2, Eq. (6.18)."""
+        return np.pi * np.asarray(b) ** 2
+
+    def volume(self, p, b, m=None):
+        """Trapped volume V*, Eq. (6.21) (0 for a closed crack)."""
+        return jkr_volume(b, p)
+
+
 # ------------------------------------------------------------ Maugis-Dugdale
 class AdhesiveCrack:
     """Maugis-Dugdale penny-shaped adhesive crack for one sigma0* (6.22)-(6.39).
@@ -119,6 +189,8 @@ class AdhesiveCrack:
             qB = minimize_scalar(self.p_of_q, bounds=(lo, hi), method="bounded",
                                  options={"xatol": 1e-13}).x
         self.qB = qB
+        q_table = qB + (self.Q_MAX - qB) * np.linspace(0.0, 1.0, 2001) ** 2     # p*(q) on the stable branch
+        self._table = (q_table, self.p_of_q(q_table))
         s = self.sigma
         pB, bB, mB = self.p_of_q(qB), self.b_of_q(qB), self.m_of_q(qB)
         pF, bF = s + 1.5 * s ** (-2.0 / 3.0), s ** (-1.0 / 3.0)            # (6.39)
@@ -126,6 +198,10 @@ class AdhesiveCrack:
         qG = self._stable_q(np.array([pF]))[0]
         self.points = {"B": (pB, bB, mB), "C": (pB, bC, 0.0), "E": (s, 0.0, 0.0),
                        "F": (pF, bF, 0.0), "G": (pF, self.b_of_q(qG), self.m_of_q(qG))}
+
+    def breakpoints(self):
+        """The p* at which the state of a crack changes with its history: B, E (6.38) and F (6.39)."""
+        return sorted({self.points["B"][0], self.sigma, self.points["F"][0]})
 
     # curve parametrisation --------------------------------------------------
     @staticmethod
@@ -153,15 +229,30 @@ class AdhesiveCrack:
         return 1.5 * self.b_of_q(q) ** 2 + self.sigma * np.sqrt(1.0 - m * m)
 
     def _stable_q(self, p):
-        """q on the stable branch (q >= qB) with p*(q) = p (vectorised bisection)."""
-        lo = np.full(p.shape, self.qB)
-        hi = np.full(p.shape, self.Q_MAX)
+        """q on the stable branch (q >= qB) with p*(q) = p, to round-off.
+
+        The bracket comes from a table of p*(q) on the branch (increasing there), clustered at B; then
+        regula falsi with the Illinois modification (superlinear, and safe at B where the slope vanishes)."""
+        q_table, p_table = self._table
+        i = np.clip(np.searchsorted(p_table, p), 1, q_table.size - 1)
+        lo, hi = q_table[i - 1], q_table[i]
+        f_lo, f_hi = p_table[i - 1] - p, p_table[i] - p
+        side = np.zeros(p.shape)
+        q = lo
         for _ in range(100):
-            mid = 0.5 * (lo + hi)
-            below = self.p_of_q(mid) < p
-            lo = np.where(below, mid, lo)
-            hi = np.where(below, hi, mid)
-        return 0.5 * (lo + hi)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                q = np.where(f_hi != f_lo, (lo * f_hi - hi * f_lo) / (f_hi - f_lo), 0.5 * (lo + hi))
+            q = np.clip(q, lo, hi)
+            f = self.p_of_q(q) - p
+            below = f < 0
+            # Illinois: halve the value kept at the end that stays, after it stayed twice
+            f_hi = np.where(below, np.where(side < 0, 0.5 * f_hi, f_hi), f)
+            f_lo = np.where(below, f, np.where(side > 0, 0.5 * f_lo, f_lo))
+            lo, hi = np.where(below, q, lo), np.where(below, hi, q)
+            side = np.where(below, -1.0, 1.0)
+            if np.all((np.abs(f) <= 1e-15 * np.abs(p)) | (hi - lo <= 4e-16 * hi)):
+                break
+        return q
 
     def curve(self, n=2001, q_max=12.0):
         """The Maugis-Dugdale solution curve (p*, b*, m) from F (m = 0) towards A,
@@ -244,6 +335,9 @@ class AdhesiveCrack:
 
 
 # -------------------------------------------------------- adhesive GW model
+CRACK_LAWS = ("maugis-dugdale", "jkr")
+
+
 class AdhesiveGW:
     """Adhesive adapted GW model of nearly complete contact, Eqs. (6.40)-(6.54).
 
@@ -256,13 +350,24 @@ class AdhesiveGW:
     z0 : float
         Range of adhesion [length]; the surface energy is w = sigma0 z0
         (the convention that gives (6.56)).
+    n_elements : int
+        Gauss-Legendre elements (8 points each) per interval between the crack's breakpoints and on
+        the semi-infinite tail.
+    crack_law : {"maugis-dugdale", "jkr"}
+        The single crack: :class:`AdhesiveCrack` at the sigma0* of (6.6), or its limit sigma0 -> inf at
+        the same w, :class:`JKRCrack` (the "JKR limit" curves of Figs. 6.9-6.10). The scales C, C1, C2
+        depend on w alone, so both laws share them.
 
     All results are dimensionless: p* = pbar/sqrt(m0^p), g* = gbar/sqrt(m0^h).
     """
 
-    def __init__(self, m0h, m2h, m4h, m6h, sigma0_over_E, z0, n_elements=16):
+    XI_CUT = 12.0   # the summit-height density (2.42) is below exp(-C1 xi^2) <= exp(-72) beyond xi* = 12
+
+    def __init__(self, m0h, m2h, m4h, m6h, sigma0_over_E, z0, n_elements=16, crack_law="maugis-dugdale"):
         if min(m0h, m2h, m4h, m6h, sigma0_over_E, z0) <= 0:
             raise ValueError("moments, sigma0/E* and z0 must be positive")
+        if crack_law not in CRACK_LAWS:
+            raise ValueError(f"crack_law is one of {', '.join(CRACK_LAWS)}, got {crack_law!r}")
         self.m0h = m0h
         self.m0p, self.m2p, self.m4p = m2h / 2.0, m4h / 3.0, 0.3 * m6h        # (2.53), over E*^2
         self.alpha_p = self.m0p * self.m4p / self.m2p ** 2                    # (2.54)
@@ -276,23 +381,28 @@ class AdhesiveGW:
         self.C = np.sqrt(self.m0p) / Pscale                                   # (6.45)
         self.C1 = self.eta * Lscale ** 2                                      # (6.48)
         self.C2 = self.eta / np.sqrt(m0h) * 1.5 * w / self.kappa              # (6.49)
-        self.crack = AdhesiveCrack(self.sigma_star)
+        self.crack = AdhesiveCrack(self.sigma_star) if crack_law == "maugis-dugdale" else JKRCrack()
         self.n_elements = n_elements
 
     def _integrate(self, pbar, pbar_max):
         """1 - A* and g* at pbar after a loading history that reached pbar_max >= pbar."""
         c = self.crack
-        breaks = sorted({c.points["B"][0], c.sigma, c.points["F"][0]})
+        breaks = c.breakpoints()
         # local p* = (xi - pbar) C; history minimum (xi - pbar_max) C
         shift = pbar - pbar_max            # <= 0 : p_min = p + shift C
+        # Breakpoints beyond the summit heights that carry weight are dropped: a far one (E and F recede
+        # as sigma0* grows) would stretch the elements of the last interval over the whole density.
+        cut = (max(pbar, 0.0) + self.XI_CUT) * self.C
         edges = [0.0] + [bk for bk in breaks if bk > 0] + \
-                [bk - shift * self.C for bk in breaks if bk - shift * self.C > 0]
-        edges = np.unique(np.array(edges))
+                [bk - shift * self.C for bk in breaks if bk - shift * self.C > 0] + [cut]
+        edges = np.unique(np.array([e for e in edges if e <= cut]))
         nodes, weights = [], []
         for a, b in zip(edges[:-1], edges[1:]):
-            x, w = gauss_legendre(self.n_elements, 8, a, b)
-            nodes.append(x)
-            weights.append(w)
+            # p = a + (b - a) u^2: the radius grows as sqrt(p - a) from B (6.15) and from E (6.36), and
+            # the map makes such a start smooth in u.
+            u, w = gauss_legendre(self.n_elements, 8, 0.0, 1.0)
+            nodes.append(a + (b - a) * u * u)
+            weights.append(2.0 * (b - a) * u * w)
         t, w = semi_infinite(self.n_elements, 8, scale=self.C, power=2)
         nodes.append(edges[-1] + t)
         weights.append(w)
@@ -317,3 +427,15 @@ class AdhesiveGW:
             raise ValueError("unloading p* must not exceed pstar_max")
         out = np.array([self._integrate(pi, pstar_max) for pi in p])
         return 1.0 - out[:, 0], out[:, 1]
+
+    def dissipated_energy(self, pstar_max, pstar_min=0.0, n_elements=24):
+        """Area between the loading and unloading g*(p*) curves over [pstar_min, pstar_max] (Fig. 6.11(b)).
+
+        int (g*_loading - g*_unloading) dp*, the energy per unit area dissipated in the cycle down to
+        ``pstar_min`` and back, over sqrt(m0^p) sqrt(m0^h) (the section's "subtraction of the area
+        underneath the loading and unloading stages"). Composite Gauss-Legendre in p*.
+        """
+        if not pstar_max > pstar_min:
+            raise ValueError("pstar_max must exceed pstar_min")
+        p, w = gauss_legendre(n_elements, 8, pstar_min, pstar_max)
+        return float(np.sum(w * (self.loading(p)[1] - self.unloading(p, pstar_max)[1])))
