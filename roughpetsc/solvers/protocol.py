@@ -103,14 +103,6 @@ class BackendSettings:
     rule: StoppingRule
     prefix: str = None
 
-    @property
-    def rtol(self):
-        return self.rule.rtol
-
-    @property
-    def max_seconds(self):
-        return self.rule.max_seconds
-
 
 class Backend:
     """The defaults of the optional parts of the backend protocol; backends may derive from it."""

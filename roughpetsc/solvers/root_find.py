@@ -40,7 +40,7 @@ class RootFind(Backend):
     def __init__(self, problem, control, tao_type, settings, max_evaluations=100, inner=None):
         self.qp = inner or BoundQP(problem, "displacement", tao_type, settings)
         self.problem = problem
-        self.rtol = settings.rtol
+        self.rtol = settings.rule.rtol
         self.max_evaluations = max_evaluations
         self.name = f"rootfind({self.qp.name})"
         self.bracket = {"above": problem.vec(), "below": problem.vec()}  # solutions either side of the load

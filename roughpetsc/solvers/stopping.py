@@ -226,14 +226,6 @@ class ConvergenceTest:
         self.iteration_offset = 0
         self.verdict = Verdict.CONTINUE
 
-    @property
-    def best_natural(self):
-        return self.watch.best_natural
-
-    @property
-    def stopped_by(self):
-        return self.watch.stopped_by
-
     def __call__(self, tao):
         natural, load_error, fresh = self.evaluate(tao)
         iteration = tao.getIterationNumber()
