@@ -40,11 +40,6 @@ def all_options():
     return {name: default for name, default, _ in table + solve_mode.solver_options()}
 
 
-def all_option_names():
-    """The names of every option of roughpetsc (general, surface, each mode's)."""
-    return set(all_options())
-
-
 def format_help(title, option_table):
     """Lines of -help for a table of ``(name, default, help)``."""
     lines = [title]
@@ -199,10 +194,10 @@ def check_memory(reader, comm, mode):
 
     from . import surface_options
 
-    if mode not in ("solve", "stats", "ensemble") or reader.string("surface_file", ""):
+    if mode not in ("solve", "stats", "ensemble") or reader.getString("surface_file", ""):
         return
     grid = surface_options.grid_from_options(reader)
-    share = {"solve": comm.Get_size(), "stats": 1, "ensemble": max(1, reader.int("ensemble_group_ranks", 1))}[mode]
+    share = {"solve": comm.Get_size(), "stats": 1, "ensemble": max(1, reader.getInt("ensemble_group_ranks", 1))}[mode]
     host = comm.Split_type(MPI.COMM_TYPE_SHARED)
     ranks_here = host.Get_size()
     host.Free()
@@ -278,7 +273,7 @@ def run_command_line(argv=None):
     comm = PETSc.COMM_WORLD.tompi4py()
     reader = Reader()
     try:
-        if reader.has("help"):
+        if reader.hasName("help"):
             return 0
         if version:
             if comm.Get_rank() == 0:
@@ -287,10 +282,11 @@ def run_command_line(argv=None):
         if preset_error:
             raise UserError(preset_error)
         translate_renamed_options()
-        check_names(all_option_names())
-        check_values_given(all_options())
-        reader.bool("quiet", False)  # every mode's option (read here, so that no mode reports it unused)
-        mode = reader.string("mode", "solve")
+        options = all_options()
+        check_names(set(options))
+        check_values_given(options)
+        reader.getBool("quiet", False)  # every mode's option (read here, so that no mode reports it unused)
+        mode = reader.getString("mode", "solve")
         if mode not in MODES:
             raise UserError(f"-mode: unknown mode '{mode}' (one of {', '.join(MODES)})")
         check_memory(reader, comm, mode)

@@ -127,15 +127,6 @@ def output_paths(settings):
             ("stats_plot", f"{plot}_h.png" if plot else ""), ("stats_plot", f"{plot}_p.png" if plot else "")]
 
 
-def surface_settings(options):
-    """The surface options this run uses, as read (for the record): ``{name: value}``, typed by their defaults.
-
-    Those of the surface type (:func:`roughpetsc.surface_options.parameters`), so that one the run does not use
-    is reported as unused.
-    """
-    return surface_options.parameters(options)
-
-
 def histogram_edges(bin_width):
     """Bin edges on :data:`PDF_RANGE` with the given width (dimensionless)."""
     count = int(round((PDF_RANGE[1] - PDF_RANGE[0]) / bin_width))
@@ -327,7 +318,8 @@ def pdf_distances(summary):
 def compute(options, comm, settings, surface):
     """Compute the statistics on all ranks; the result document on rank 0, None elsewhere.
 
-    ``settings`` are :func:`read_settings` of ``options``, ``surface`` :func:`surface_settings`.
+    ``settings`` are :func:`read_settings` of ``options``, ``surface`` the surface options as read for the record
+    (:func:`roughpetsc.app.surface_options.parameters`).
     """
     record = settings.record()
     realisation_seeds = surface_seeds(settings)
@@ -383,7 +375,7 @@ def run(options, comm):
     from .options import check_unused  # imports PETSc: only once the command line has initialised it
 
     settings = read_settings(options)
-    surface = surface_settings(options)
+    surface = surface_options.parameters(options)  # those of the surface type: another is reported unused
     # Rank 0 checks the files and writes them; a failure there is raised on every rank (no rank left waiting).
     on_root(comm, check_outputs, output_paths(settings), options.getBool("overwrite", False),
             [("surface_file", options.getString("surface_file", ""))])

@@ -5,7 +5,6 @@ import json
 
 from ..contact import loads
 from ..app import settings as mode_settings
-from ..surface import seeds
 from ..errors import UserError
 from ..store.outputs import check_writable
 from ..app.settings import Option
