@@ -181,14 +181,14 @@ class Watch:
         updated one asks for confirmation (``CONFIRM``, nothing recorded) when ``confirm`` is True.
         """
         self.improved = False
+        merit = natural if load_error is None else max(natural, load_error)
         if self.converged(natural, load_error):
             if not fresh and confirm:
                 return Verdict.CONFIRM
             self.history.record(iteration, natural)
-            self.best_natural = natural if load_error is None else max(natural, load_error)
+            self.best_natural = merit
             return Verdict.CONVERGED
         self.history.record(iteration, natural)
-        merit = natural if load_error is None else max(natural, load_error)
         if merit < self.best_natural:
             self.best_natural, self.best_iteration, self.improved = merit, iteration, True
         if self.inner_eta and load_error is not None and natural <= self.inner_eta * load_error:
