@@ -22,6 +22,7 @@ from ..errors import ParameterError, UserError
 from .settings import GENERAL_OPTIONS, user_message
 from . import models_mode
 from .presets import PRESET_FOLDERS, ROOT, preset_names
+from .terminal import launcher_rank
 
 # The modes of -mode, in -help order. Each module has OPTIONS (its -help table) and run(options, comm), which
 # does the whole mode (the check that every option was used included) and returns the exit status, or its
@@ -156,14 +157,6 @@ def options_file_error(path, found):
             return (f"-options_file {path}: line {number} '{shown}' is not an option (an options file holds "
                     "'-name value' lines and # comments)")
     return None
-
-
-def launcher_rank():
-    """This process's MPI rank as the launcher tells it (MPI is not initialised yet); 0 if not under mpiexec."""
-    for name in ("OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"):
-        if os.environ.get(name, "").isdigit():
-            return int(os.environ[name])
-    return 0
 
 
 # Measured peak of a solve (studies/output/memory.md): at most 40 doubles per grid point of a rank.
