@@ -3,8 +3,8 @@
 The names are those of ``-tao_type`` (and of ``Solver(..., tao_type=...)``): for the elastic contact
 problem the bound-constrained TAO types, ``almm`` and ``pk`` (also ``none``, ``python``, or no name: the
 default); for the adhesive problem ``gapcg`` (the default) and ``almm``. A name may mean a different
-backend under each control (a bound type is the QP itself under displacement control and a root find on
-the separation around it under load control). A new solver or physics registers
+backend under each control (a bound type is the QP itself under displacement control and an augmented
+Lagrangian on the load around it under load control). A new solver or physics registers
 ``register(name, factory, controls, kinds)`` in its own module, imported by :mod:`roughpetsc.solvers`, and
 declares its options in a table (:func:`option_tables`).
 """
