@@ -24,6 +24,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..errors import UserError
+from ..parallel import allmax
 
 # The iteration limit every TAO of the solvers starts with (-tao_max_it changes it): the natural-residual
 # test decides, and TAO's own limits (the BNK family stops at 50) would end solves early.
@@ -90,11 +91,7 @@ class History:
             return False
         expired = timed and time.perf_counter() - self.start > max_seconds
         asked = self.stop_requested is not None and self.stop_requested()
-        if self.mpi.Get_size() == 1:
-            return expired or asked
-        from mpi4py import MPI
-
-        return bool(self.mpi.allreduce(int((expired and self.mpi.Get_rank() == 0) or asked), op=MPI.MAX))
+        return bool(allmax(self.mpi, [(expired and self.mpi.Get_rank() == 0) or asked])[0])
 
     def as_array(self):
         return np.array(self.rows, dtype=np.float64).reshape(-1, 4)
