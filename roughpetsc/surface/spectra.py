@@ -160,7 +160,7 @@ def spectral_moments(grid, field, orders=MOMENT_ORDERS):
     is the variance.
     """
     k0, k1 = grid.rfft_wavenumbers()
-    power = power_spectrum(grid, field)
+    power = power_spectrum(grid, field).copy()  # C order (rfft2's is not): the order of the sums below
     power[0, 0] = 0.0
     angular = {"x": 2.0 * np.pi * k1, "y": 2.0 * np.pi * k0}
     moments = {}
