@@ -22,6 +22,7 @@ from ..errors import ParameterError, UserError
 from .settings import GENERAL_OPTIONS, user_message
 from . import models_mode
 from .presets import PRESET_FOLDERS, ROOT, preset_names
+from .terminal import launcher_rank
 
 # The modes of -mode, in -help order. Each module has OPTIONS (its -help table) and run(options, comm), which
 # does the whole mode (the check that every option was used included) and returns the exit status, or its
@@ -38,11 +39,6 @@ def all_options():
 
     table = GENERAL_OPTIONS + SURFACE_OPTIONS + [option for module in MODES.values() for option in module.OPTIONS]
     return {name: default for name, default, _ in table + solve_mode.solver_options()}
-
-
-def all_option_names():
-    """The names of every option of roughpetsc (general, surface, each mode's)."""
-    return set(all_options())
 
 
 def format_help(title, option_table):
@@ -163,14 +159,6 @@ def options_file_error(path, found):
     return None
 
 
-def launcher_rank():
-    """This process's MPI rank as the launcher tells it (MPI is not initialised yet); 0 if not under mpiexec."""
-    for name in ("OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"):
-        if os.environ.get(name, "").isdigit():
-            return int(os.environ[name])
-    return 0
-
-
 # Measured peak of a solve (studies/output/memory.md): at most 40 doubles per grid point of a rank.
 PEAK_BYTES_PER_POINT = 40 * 8
 
@@ -199,10 +187,10 @@ def check_memory(reader, comm, mode):
 
     from . import surface_options
 
-    if mode not in ("solve", "stats", "ensemble") or reader.string("surface_file", ""):
+    if mode not in ("solve", "stats", "ensemble") or reader.getString("surface_file", ""):
         return
     grid = surface_options.grid_from_options(reader)
-    share = {"solve": comm.Get_size(), "stats": 1, "ensemble": max(1, reader.int("ensemble_group_ranks", 1))}[mode]
+    share = {"solve": comm.Get_size(), "stats": 1, "ensemble": max(1, reader.getInt("ensemble_group_ranks", 1))}[mode]
     host = comm.Split_type(MPI.COMM_TYPE_SHARED)
     ranks_here = host.Get_size()
     host.Free()
@@ -278,7 +266,7 @@ def run_command_line(argv=None):
     comm = PETSc.COMM_WORLD.tompi4py()
     reader = Reader()
     try:
-        if reader.has("help"):
+        if reader.hasName("help"):
             return 0
         if version:
             if comm.Get_rank() == 0:
@@ -287,10 +275,11 @@ def run_command_line(argv=None):
         if preset_error:
             raise UserError(preset_error)
         translate_renamed_options()
-        check_names(all_option_names())
-        check_values_given(all_options())
-        reader.bool("quiet", False)  # every mode's option (read here, so that no mode reports it unused)
-        mode = reader.string("mode", "solve")
+        options = all_options()
+        check_names(set(options))
+        check_values_given(options)
+        reader.getBool("quiet", False)  # every mode's option (read here, so that no mode reports it unused)
+        mode = reader.getString("mode", "solve")
         if mode not in MODES:
             raise UserError(f"-mode: unknown mode '{mode}' (one of {', '.join(MODES)})")
         check_memory(reader, comm, mode)

@@ -11,6 +11,8 @@ signal raises ``KeyboardInterrupt`` at once, for a person who does not want to w
 
 import signal
 
+from ..parallel import allmax
+
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
@@ -47,9 +49,4 @@ class StopRequests:
 
 def agreed(comm, flag):
     """``flag`` of any rank of ``comm`` (mpi4py), on every rank: collective."""
-    flag = bool(flag)
-    if comm is None or comm.Get_size() == 1:
-        return flag
-    from mpi4py import MPI
-
-    return bool(comm.allreduce(int(flag), op=MPI.MAX))
+    return bool(flag) if comm is None else bool(allmax(comm, [bool(flag)])[0])

@@ -21,9 +21,10 @@ PETSC4PY_STRING_BUFFER = 1024
 
 
 class Reader:
-    """Typed reads from the options database that name the option on bad values.
+    """Typed reads from the options database that name the option on bad values, with the getters of
+    ``petsc4py.PETSc.Options`` (so that the readers of option tables take either).
 
-    Strings are read whole, whatever their length (:meth:`string`); lists are read by :meth:`reals`.
+    Strings are read whole, whatever their length (:meth:`getString`); lists are read by :meth:`reals`.
     """
 
     def __init__(self, database=None):
@@ -35,37 +36,28 @@ class Reader:
         except PETSc.Error:
             raise UserError(f"-{name}: cannot read the value '{self.database.getString(name, '')}'") from None
 
-    def real(self, name, default):
+    def getReal(self, name, default):
         return self._get(self.database.getReal, name, default)
 
-    def int(self, name, default):
+    def getInt(self, name, default):
         return self._get(self.database.getInt, name, default)
 
-    def string(self, name, default):
+    def getString(self, name, default):
         """The value of ``-name`` as given (any length), or ``default`` if the option is absent."""
         text = self._get(self.database.getString, name, default)
         return whole_string(name, text, self.database.prefix) if self.database.hasName(name) else text
 
-    def bool(self, name, default):
+    def getBool(self, name, default):
         return self._get(self.database.getBool, name, default)
 
-    def has(self, name):
+    def hasName(self, name):
         return self.database.hasName(name)
 
     def reals(self, name):
         """The list of reals of ``-name`` (:func:`parse_reals`), or None if the option is absent."""
         if not self.database.hasName(name):
             return None
-        return parse_reals(self.string(name, ""), name)
-
-    # petsc4py.PETSc.Options-like interface for modules that expect it
-    getReal = real
-    getInt = int
-    getString = string
-    getBool = bool
-
-    def hasName(self, name):
-        return self.has(name)
+        return parse_reals(self.getString(name, ""), name)
 
 
 def whole_string(name, text, prefix=None):

@@ -1,6 +1,6 @@
 """Option tables of the modes and the checks they share: one table feeds ``-help`` and the settings.
 
-A table is a list of :class:`Option` ``(name, default, help)``; the option's type is its default's
+A table is a list of ``(name, default, help)`` tuples; the option's type is its default's
 (``int``, ``float``, ``str``, ``bool``). ``roughpetsc.cli`` prints the tables for ``-help`` and
 knows every option name from them; :func:`read_table` reads a whole table from the options
 database, and each mode turns that into its frozen settings dataclass
@@ -18,7 +18,6 @@ options, so they raise :class:`~roughpetsc.errors.UserError` naming the option.
 
 from contextlib import contextmanager
 import math
-from typing import NamedTuple
 
 from ..fft import plans as fftw
 from . import surface_options
@@ -78,18 +77,6 @@ def options_named():
         yield
     except ParameterError as error:
         raise UserError(user_message(error)) from None
-
-
-class Option(NamedTuple):
-    """One option of a table: its name (without the dash), its default (whose type is the option's) and help."""
-
-    name: str
-    default: object
-    help: str
-
-    @property
-    def type(self):
-        return type(self.default)
 
 
 def read_table(options, table):

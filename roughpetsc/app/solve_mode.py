@@ -138,19 +138,19 @@ class SolveSettings:
 
 def load_steps(reader):
     """The list of loads: ``("pstar" | "pbar" | "gbar", value)`` in the order to solve, and the option."""
-    given = [name for name in LOAD_KINDS if reader.has(name)]
+    given = [name for name in LOAD_KINDS if reader.hasName(name)]
     if len(given) > 1:
         raise UserError(f"give only one of {', '.join('-' + name for name in LOAD_KINDS)}; got "
                         + ", ".join("-" + g for g in given))
     name = given[0] if given else "pstar"
     kind = LOAD_KINDS[name]
-    if name == "pstar_list" and reader.string(name, "").strip().lower() == "history":
+    if name == "pstar_list" and reader.getString(name, "").strip().lower() == "history":
         from ..contact import loads
 
         return [(kind, float(v)) for v in loads.history()], name
     if name.endswith("_list"):
         return [(kind, v) for v in reader.reals(name)], name
-    return [(kind, reader.real(name, 0.5))], name
+    return [(kind, reader.getReal(name, 0.5))], name
 
 
 def read_settings(reader, general_options=GENERAL_OPTIONS):
@@ -167,8 +167,9 @@ def read_settings(reader, general_options=GENERAL_OPTIONS):
     names = {field.name for field in fields(SolveSettings)}
     values = {name: value for name, value in read_table(reader, general_options + SETTINGS_OPTIONS).items()
               if name in names}
-    settings = SolveSettings(steps=tuple(steps), load_option=load_option, tao_type=reader.string("tao_type", "") or None,
-                             surface_file=reader.string("surface_file", ""), **values, **read_physics(reader))
+    settings = SolveSettings(steps=tuple(steps), load_option=load_option,
+                             tao_type=reader.getString("tao_type", "") or None,
+                             surface_file=reader.getString("surface_file", ""), **values, **read_physics(reader))
     check_rtol(settings.kkt_rtol)
     check_modulus(settings.E_star)
     if settings.output_fields not in OUTPUT_FIELDS:
@@ -197,14 +198,14 @@ def read_physics(reader):
     hardness = values["hardness"]
     if not (hardness >= 0 and np.isfinite(hardness)):
         raise UserError(f"-hardness must be a positive pressure (0: no cap), got {hardness}")
-    depths = tuple(reader.reals("stress_depths")) if reader.has("stress_depths") else ()
+    depths = tuple(reader.reals("stress_depths")) if reader.hasName("stress_depths") else ()
     with options_named():
         if depths:
             check_depths(depths)
         check_poisson(values["nu"])
     return {"boundary": values["boundary"], "hardness": hardness or None, "stress_depths": depths,
             "nu": values["nu"],
-            "adhesion": adhesive_options.read_law(values, {name for name in values if reader.has(name)})}
+            "adhesion": adhesive_options.read_law(values, {name for name in values if reader.hasName(name)})}
 
 
 def check_files(settings, comm):

@@ -29,26 +29,26 @@ from ..surface import summits as asperities, seeds, spectra
 from . import settings as mode_settings
 from ..errors import ParameterError, UserError
 from ..store.outputs import check_outputs, on_root
-from .settings import ENSEMBLE_SEED, Option
+from .settings import ENSEMBLE_SEED
 from .stats_output import FIELDS, closed_form_pdfs, report, result_document
 from ..surface.generators import fractal_amplitude
 from .surface_options import from_options
 
 OPTIONS = [
-    Option("stats_ensemble", 0, "number of realisations (seeds from -ensemble_seed, as in -mode ensemble); 0 = "
-                                "the one surface of the options"),
-    Option(*ENSEMBLE_SEED),
-    Option("stats_json", "", "write the statistics as JSON to PATH"),
-    Option("stats_h5", "", "write the statistics and per-surface values to HDF5 PATH"),
-    Option("stats_plot", "", "write PNG plots of the PDFs against the closed forms to PREFIX_h.png and "
-                             "PREFIX_p.png"),
-    Option("stats_bin_width", 0.25, "bin width of the PDF histograms, in units of sqrt(m0) or sqrt(m4)"),
-    Option("stats_fd_scheme", "seed", "finite-difference stencils of (7.6)/(7.7): seed (the dissertation's) | "
-                                      "central"),
-    Option("stats_psd", "", "write the radially averaged PSD of the surface(s) to PATH (CSV: k, PSD, modes, the fit) "
-                            "with the fit of (2.18) C k^-2(1+H) over -stats_psd_band"),
-    Option("stats_psd_band", "", "k_min,k_max [cycles/length] of the PSD fit; default k_l,k_s of a fractal "
-                                 "surface, else the fundamental to the Nyquist wavenumber"),
+    ("stats_ensemble", 0, "number of realisations (seeds from -ensemble_seed, as in -mode ensemble); 0 = "
+                          "the one surface of the options"),
+    ENSEMBLE_SEED,
+    ("stats_json", "", "write the statistics as JSON to PATH"),
+    ("stats_h5", "", "write the statistics and per-surface values to HDF5 PATH"),
+    ("stats_plot", "", "write PNG plots of the PDFs against the closed forms to PREFIX_h.png and "
+                       "PREFIX_p.png"),
+    ("stats_bin_width", 0.25, "bin width of the PDF histograms, in units of sqrt(m0) or sqrt(m4)"),
+    ("stats_fd_scheme", "seed", "finite-difference stencils of (7.6)/(7.7): seed (the dissertation's) | "
+                                "central"),
+    ("stats_psd", "", "write the radially averaged PSD of the surface(s) to PATH (CSV: k, PSD, modes, the fit) "
+                      "with the fit of (2.18) C k^-2(1+H) over -stats_psd_band"),
+    ("stats_psd_band", "", "k_min,k_max [cycles/length] of the PSD fit; default k_l,k_s of a fractal "
+                           "surface, else the fundamental to the Nyquist wavenumber"),
 ]
 
 PDF_RANGE = (-5.0, 5.0)
@@ -125,15 +125,6 @@ def output_paths(settings):
     plot = settings.plot
     return [("stats_json", settings.json), ("stats_h5", settings.h5), ("stats_psd", settings.psd),
             ("stats_plot", f"{plot}_h.png" if plot else ""), ("stats_plot", f"{plot}_p.png" if plot else "")]
-
-
-def surface_settings(options):
-    """The surface options this run uses, as read (for the record): ``{name: value}``, typed by their defaults.
-
-    Those of the surface type (:func:`roughpetsc.surface_options.parameters`), so that one the run does not use
-    is reported as unused.
-    """
-    return surface_options.parameters(options)
 
 
 def histogram_edges(bin_width):
@@ -327,7 +318,8 @@ def pdf_distances(summary):
 def compute(options, comm, settings, surface):
     """Compute the statistics on all ranks; the result document on rank 0, None elsewhere.
 
-    ``settings`` are :func:`read_settings` of ``options``, ``surface`` :func:`surface_settings`.
+    ``settings`` are :func:`read_settings` of ``options``, ``surface`` the surface options as read for the record
+    (:func:`roughpetsc.app.surface_options.parameters`).
     """
     record = settings.record()
     realisation_seeds = surface_seeds(settings)
@@ -383,7 +375,7 @@ def run(options, comm):
     from .options import check_unused  # imports PETSc: only once the command line has initialised it
 
     settings = read_settings(options)
-    surface = surface_settings(options)
+    surface = surface_options.parameters(options)  # those of the surface type: another is reported unused
     # Rank 0 checks the files and writes them; a failure there is raised on every rank (no rank left waiting).
     on_root(comm, check_outputs, output_paths(settings), options.getBool("overwrite", False),
             [("surface_file", options.getString("surface_file", ""))])

@@ -23,6 +23,14 @@ def under_launcher(environ=os.environ):
     return any(name in environ for name in LAUNCHER_VARIABLES)
 
 
+def launcher_rank():
+    """This process's MPI rank as the launcher tells it (MPI is not initialised yet); 0 if not under mpiexec."""
+    for name in ("OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"):
+        if os.environ.get(name, "").isdigit():
+            return int(os.environ[name])
+    return 0
+
+
 def _parent(pid):
     """``(name, parent pid)`` of process ``pid`` from /proc, or None where it cannot be read."""
     try:

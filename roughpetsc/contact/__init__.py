@@ -14,7 +14,6 @@ __getattr__, __dir__, __all__ = exports(__name__, {
     "measure": ("result", "measure"),
     "KKTReport": ("certificate", "KKTReport"),
     "report": ("certificate", "report"),
-    "merit": ("certificate", "merit"),
     "CompositeCriterion": ("certificate", "CompositeCriterion"),
     "Dugdale": ("laws", "Dugdale"),
     "Exponential": ("laws", "Exponential"),

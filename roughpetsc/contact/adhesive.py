@@ -39,7 +39,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..parallel import allmax, allmin, allsum
 from . import loops
-from .certificate import KKTReport
+from .certificate import KKTReport, certified
 from .result import Result, measure
 
 
@@ -172,18 +172,13 @@ class AdhesiveProblem:
 
         ``work`` receives S (g + h) (the pressure of :meth:`fields`).
         """
-        from ..solvers.protocol import not_certified, quote_certificate
-
         self.elastic_pressure(unknown, work)
         g = self.local(unknown, readonly=True)
         elastic = self.local(work, readonly=True)
         _, lam, kkt = self.stationarity(g, elastic)
         total, = allsum(self.mpi, [g.sum()])
         kkt.load_error = abs(total / self.n - target)  # the prescribed mean gap's error, over sqrt(m0^h)
-        converged = kkt.natural <= rtol and kkt.load_error <= rtol
-        reason = outcome.reason if converged else quote_certificate(outcome.reason, kkt, "mean gap error")
-        if not converged and reason.startswith("CONVERGED"):
-            reason = not_certified(reason, kkt, "mean gap error", "S g")
+        converged, reason = certified(outcome.reason, kkt, rtol, "mean gap error", "S g")
         in_contact = (g == 0).astype(np.float64)
         measures = measure(self.elastic_problem, in_contact, g)
         pbar = -lam * self.pressure_scale

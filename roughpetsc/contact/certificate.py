@@ -9,6 +9,7 @@ as they are.
 """
 
 from dataclasses import dataclass, asdict
+import re
 
 import numpy as np
 from petsc4py import PETSc
@@ -85,14 +86,28 @@ def report(comm, pressure, gap, n_total, target_pbar=None, upper=None):
     )
 
 
-def merit(kkt):
-    """One number for "how far from the solution": the natural residual, and the load error if there is one.
+# The note of describe_stop (roughpetsc.solvers.stopping) that quotes the residual of the solver's best iterate.
+BEST_NOTE = re.compile(r"best (of natural residual, load error|natural residual) [^,)]+")
 
-    A load-controlled iterate with a small natural residual but the wrong mean pressure is not
-    close to the solution (ALMM's early iterates), so the best iterate of a solve and the floor it
-    reports are judged by both.
+
+def certified(reason, kkt, rtol, load_name="load error", gradient="gap"):
+    """``(converged, reason)`` of a result whose certificate, on a fresh ``gradient``, is ``kkt``.
+
+    Converged: the natural residual and the load error are at most ``rtol``; the solver's ``reason`` stands.
+    Otherwise a solver's own best residual (ALMM's merit, on its cached gradient, of an iterate it may not
+    return) can differ from the certificate of the result, which the output files record: the reason quotes
+    the latter, so that the line and the files give the same numbers, and a reason whose solver's own test
+    passed becomes ``NOT_CERTIFIED``.
     """
-    return kkt.natural if kkt.load_error is None else max(kkt.natural, kkt.load_error)
+    if kkt.natural <= rtol and (kkt.load_error is None or kkt.load_error <= rtol):
+        return True, reason
+    measured = f"natural residual {kkt.natural:.2g}"
+    if kkt.load_error is not None:
+        measured += f", {load_name} {kkt.load_error:.2g}"
+    reason = BEST_NOTE.sub(measured, reason, count=1)
+    if reason.startswith(("CONVERGED", "COMPLETE")):
+        reason = f"NOT_CERTIFIED ({reason}, but on a fresh {gradient}: {measured})"
+    return False, reason
 
 
 class CompositeCriterion:

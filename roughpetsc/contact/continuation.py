@@ -3,14 +3,9 @@
 :class:`PressureContinuation` (the elastic contact problem, pressure as the unknown) and
 :class:`GapContinuation` (the adhesive problem, gap as the unknown) follow the continuation protocol of
 :mod:`roughpetsc.solvers.protocol`: ``unknown``, ``start(control, target, start) -> Guess``,
-``record(control, target, outcome, work)``, ``destroy()``.
-
-Pressure: the start of each load-controlled solve comes from the previous solutions.
-
-After two load-controlled solves the pressure is extrapolated linearly in the load (the predictor of a
-continuation along the load path, e.g. the history (7.11) of the dissertation), projected onto p >= 0
-and scaled to the new mean pressure. For a backend with ``keeps_displacement`` the same combination of
-the kept K p of the previous solutions gives K p of the start (one FFT pair saved per step).
+``record(control, target, outcome, work)``, ``destroy()``. The start of each load-controlled solve of the
+pressure is predicted from the previous solutions along the load path (e.g. the history (7.11) of the
+dissertation; :meth:`PressureContinuation.load_start`).
 """
 
 import numpy as np
@@ -74,7 +69,6 @@ class PressureContinuation:
             return Guess()
         return Guess(separation=self.last_separation, displacement=self.load_start(target), confirm=False)
 
-
     def load_start(self, target):
         """Put the start of a load-controlled solve at ``target`` in :attr:`pressure`; its K p if known.
 
@@ -84,8 +78,8 @@ class PressureContinuation:
         scaled; with none, the start is uniform.
 
         Returns K p of the start when it follows from the kept K p of the previous solutions (the
-        same combination, exact when the projection changed nothing; K of a uniform pressure is 0),
-        else None. Other choices tried along the 95-step history (quadratic or cubic extrapolation in the
+        same combination, exact when the projection changed nothing; K of a uniform pressure is 0;
+        one FFT pair saved per step), else None. Other choices tried along the 95-step history (quadratic or cubic extrapolation in the
         load, linear or quadratic in log or sqrt of the load, the predicted gap's entering nodes) started
         no closer: see studies/load_history.py.
         """

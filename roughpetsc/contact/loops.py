@@ -296,7 +296,7 @@ def gradient_step(x, point, cached_gap, displacement, heights, separation, out, 
     ``displacement`` is K x (it may be ``out``). With ``cached`` (the previous point r and its gradient
     g(r) are in ``point`` and ``cached_gap``) returns the local ``(s'g(r), s'g(x))`` of the step
     s = x - r: their mean is the exact change of a quadratic objective from r to x
-    (:class:`roughpetsc.solvers.objective.QuadraticObjective`), and -s'g(r) / (s'g(x) - s'g(r)) the
+    (:class:`roughpetsc.solvers.bound_qp.AugmentedQuadratic`), and -s'g(r) / (s'g(x) - s'g(r)) the
     exact minimiser along s in units of s. Afterwards ``point = x`` and ``cached_gap = out``.
 
     Returns ``(s'g(r), s'g(x), local sum of x)``; the dots are 0 without ``cached``.

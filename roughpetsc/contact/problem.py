@@ -19,7 +19,7 @@ from ..elastic.factory import BOUNDARIES, make_operator
 from ..errors import ParameterError
 from ..parallel import allsum, allmin
 from ..surface.grid import Grid
-from .certificate import report
+from .certificate import certified, report
 from .result import Result, measure
 
 
@@ -157,14 +157,6 @@ class ContactProblem:
         """rms of the pressure surface sqrt(m0^p) (2.52), pressure units, from the field p_c of (2.47)."""
         return math.sqrt(self.m0p_scaled) * self.pressure_scale
 
-    def complete_contact_exact(self, pbar):
-        """True when ``pbar`` (scaled) reaches complete contact, where p = pbar + p_c is the exact answer.
-
-        Under a hardness cap only while that answer stays below the cap everywhere.
-        """
-        below_cap = self.upper_bound is None or pbar + self.max_pressure_surface <= self.upper_bound
-        return pbar >= self.complete_contact_pbar and below_cap
-
     def scaled_pbar(self, pbar=None, pstar=None):
         """The prescribed mean pressure in scaled units, from ``pbar`` (pressure units) or ``pstar``."""
         if pstar is not None:
@@ -203,11 +195,13 @@ class ContactProblem:
         """Beyond complete contact the exact answer is p = pbar + p_c, g = 0 (d = 0): put in ``unknown``.
 
         Returns the :class:`~roughpetsc.solvers.protocol.Outcome` of that answer, or None below complete
-        contact (and under displacement control).
+        contact (and under displacement control). Under a hardness cap only while that answer stays below the
+        cap everywhere.
         """
         from ..solvers.protocol import Outcome
 
-        if control != "load" or not self.complete_contact_exact(target):
+        below_cap = self.upper_bound is None or target + self.max_pressure_surface <= self.upper_bound
+        if control != "load" or not (target >= self.complete_contact_pbar and below_cap):
             return None
         self.pressure_surface.copy(unknown)
         unknown.shift(target)
@@ -220,19 +214,13 @@ class ContactProblem:
         the solver cached: the natural KKT residual (docs/conventions.md) and, under load control, the load
         error are checked on it against ``rtol``.
         """
-        from ..solvers.protocol import not_certified, quote_certificate
-
         load_target = target if control == "load" else None
         self.gap(unknown, outcome.separation, work)
         p = self.local(unknown, readonly=True)
         g = self.local(work, readonly=True)
         kkt = report(self.mpi, p, g, self.n, load_target, self.upper_bound)
         measures = measure(self, p, g)
-        converged = kkt.natural <= rtol and (kkt.load_error is None or kkt.load_error <= rtol)
-        reason = outcome.reason if converged else quote_certificate(outcome.reason, kkt)
-        if not converged and reason.startswith(("CONVERGED", "COMPLETE")):
-            # The solver's own test passed on its own gap; the certificate on a fresh one did not.
-            reason = not_certified(reason, kkt)
+        converged, reason = certified(outcome.reason, kkt, rtol)
         pbar = measures["pbar"] * self.pressure_scale
         gbar = measures["gbar"] * self.height_scale
         return Result(

@@ -82,11 +82,14 @@ class FilterOperator:
         self.applications += 1
         self._filter(source, target, self.preconditioner_symbol)
 
-    def mat(self):
-        """The compliance as a symmetric shell Mat (``MATPYTHON``); destroy it when done."""
+    def mat(self, context=None):
+        """The compliance as a symmetric shell Mat (``MATPYTHON``); destroy it when done.
+
+        ``context``: another MATPYTHON context on this layout (a Hessian or preconditioner made from K).
+        """
         n_local = self.local_shape[0] * self.local_shape[1]
         mat = PETSc.Mat().createPython(((n_local, self.grid.size), (n_local, self.grid.size)),
-                                       context=_ShellContext(self), comm=self.comm)
+                                       context=context or ShellContext(self), comm=self.comm)
         mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         mat.setUp()
         return mat
@@ -101,7 +104,7 @@ def per_float(symbol):
     return np.repeat(symbol, 2, axis=1)
 
 
-class _ShellContext:
+class ShellContext:
     """The MATPYTHON context of :meth:`FilterOperator.mat`: K + perturbation I.
 
     ``perturbation`` is TAO's Hessian shift: the BNK family (BNLS, BNTR, BNTL)

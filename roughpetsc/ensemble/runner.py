@@ -62,30 +62,26 @@ def share_fftw_wisdom(comm, group, s, stored):
     other rank forgets its own and imports that one before any surface is
     built. Returns the wisdom (base64 JSON) to store in the file.
     """
-    import base64
-
     import pyfftw
     from petsc4py import PETSc
 
     from ..contact.problem import ContactProblem
+    from ..fft.plans import decode_wisdom, encode_wisdom
     from ..surface.generators import wave
 
     stored = comm.bcast(stored, root=0)
     if stored:
         pyfftw.forget_wisdom()
-        pyfftw.import_wisdom(tuple(base64.b64decode(w) for w in json.loads(stored)))
+        pyfftw.import_wisdom(decode_wisdom(stored))
     if comm.Get_rank() < group.Get_size():       # group 0
         grid = s.grid
         problem = ContactProblem(grid, wave(grid, 1.0, grid.l1), s.E_star, PETSc.Comm(group), s.threads,
                                  s.effort)
         problem.destroy()
-    wisdom = None
-    if comm.Get_rank() == 0:
-        wisdom = json.dumps([base64.b64encode(w).decode() for w in pyfftw.export_wisdom()])
-    wisdom = comm.bcast(wisdom, root=0)
+    wisdom = comm.bcast(encode_wisdom(pyfftw.export_wisdom()) if comm.Get_rank() == 0 else None, root=0)
     if comm.Get_rank() != 0:
         pyfftw.forget_wisdom()
-        pyfftw.import_wisdom(tuple(base64.b64decode(w) for w in json.loads(wisdom)))
+        pyfftw.import_wisdom(decode_wisdom(wisdom))
     return wisdom
 
 

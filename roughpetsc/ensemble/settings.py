@@ -5,25 +5,23 @@ import json
 
 from ..contact import loads
 from ..app import settings as mode_settings
-from ..surface import seeds
 from ..errors import UserError
 from ..store.outputs import check_writable
-from ..app.settings import Option
 from ..parallel import row_split
 from .statistics import MODEL_NAMES
 
 OPTIONS = [
-    Option("ensemble_size", 50, "number of surfaces (indices 0..size-1; an existing file can be extended)"),
-    Option(*mode_settings.ENSEMBLE_SEED),
-    Option("ensemble_group_ranks", 1, "MPI ranks per group; each group solves whole surfaces (must divide the ranks)"),
-    Option("ensemble_loads", "history", "p* steps: 'history' (7.11, 95 steps, D1 = 0.2/30) or a comma list"),
-    Option("ensemble_models", "all", "statistical models stored beside the BEM: all | none | comma list of "
-                                     "gw,nayak_bush,greenwood,bgt,bgt_asymptotic,ciavarella,persson"),
-    Option(*mode_settings.OUTPUT),
-    Option(*mode_settings.KKT_RTOL),
-    Option(*mode_settings.FFT_THREADS),
-    Option(*mode_settings.FFT_EFFORT),
-    Option(*mode_settings.QUIET),
+    ("ensemble_size", 50, "number of surfaces (indices 0..size-1; an existing file can be extended)"),
+    mode_settings.ENSEMBLE_SEED,
+    ("ensemble_group_ranks", 1, "MPI ranks per group; each group solves whole surfaces (must divide the ranks)"),
+    ("ensemble_loads", "history", "p* steps: 'history' (7.11, 95 steps, D1 = 0.2/30) or a comma list"),
+    ("ensemble_models", "all", "statistical models stored beside the BEM: all | none | comma list of "
+                               "gw,nayak_bush,greenwood,bgt,bgt_asymptotic,ciavarella,persson"),
+    mode_settings.OUTPUT,
+    mode_settings.KKT_RTOL,
+    mode_settings.FFT_THREADS,
+    mode_settings.FFT_EFFORT,
+    mode_settings.QUIET,
 ]
 # -output of an ensemble, when not given.
 DEFAULT_OUTPUT = "ensemble.h5"

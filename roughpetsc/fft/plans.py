@@ -95,11 +95,12 @@ def check_wisdom_path(option_value, option):
         raise UserError(f"-{option} {value}: the folder {folder} does not exist")
 
 
-def _decode(text):
+def decode_wisdom(text):
+    """FFTW wisdom from its text form (JSON of base64 strings; :func:`encode_wisdom`)."""
     return tuple(base64.b64decode(item) for item in json.loads(text))
 
 
-def _encode(wisdom):
+def encode_wisdom(wisdom):
     return json.dumps([base64.b64encode(item).decode() for item in wisdom])
 
 
@@ -130,19 +131,19 @@ def remembered_plans(comm, path, effort):
         try:
             with open(path) as f:
                 stored = f.read()
-            _decode(stored)
+            decode_wisdom(stored)
         except (OSError, ValueError):
             stored = None  # a damaged cache is measured anew
     stored = comm.bcast(stored, root=0)
     if stored:
-        pyfftw.import_wisdom(_decode(stored))
+        pyfftw.import_wisdom(decode_wisdom(stored))
     yield
     # Ranks of an uneven decomposition plan other shapes than rank 0: every rank's plans are kept.
-    everyone = comm.gather(_encode(pyfftw.export_wisdom()), root=0)
+    everyone = comm.gather(encode_wisdom(pyfftw.export_wisdom()), root=0)
     if comm.Get_rank() == 0:
         for wisdom in everyone[1:]:
-            pyfftw.import_wisdom(_decode(wisdom))
-        wisdom = _encode(pyfftw.export_wisdom())
+            pyfftw.import_wisdom(decode_wisdom(wisdom))
+        wisdom = encode_wisdom(pyfftw.export_wisdom())
         if wisdom != stored:
             _write_quietly(path, wisdom)
 

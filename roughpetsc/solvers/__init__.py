@@ -15,7 +15,7 @@ One concept per module:
   :mod:`.polonsky_keer`), :mod:`.bound_qp` (any bound-constrained TAO type, displacement control),
   :mod:`.root_find` (load control by a root find on the separation around it), :mod:`.almm` (TAO ALMM),
   :mod:`.gap_cg` and :mod:`.adhesive_almm` (the adhesive problem);
-- :mod:`.objective` (the QP's objective for TAO), :mod:`.preconditioner` (the Fourier preconditioner).
+- :mod:`.preconditioner` (the Fourier preconditioner).
 
 A new solver or physics adds one module that registers its factory and one import line here.
 """

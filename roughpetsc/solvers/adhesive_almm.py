@@ -45,12 +45,9 @@ class AdhesiveALMM(MeanConstrainedALMM):
         x = tao.getSolution()
         problem.elastic_pressure(x, self.elastic)
         g = problem.local(x, readonly=True).ravel()
-        elastic = problem.local(self.elastic, readonly=True).ravel()
-        r, open_nodes = np.empty_like(g), np.empty(g.shape, dtype=bool)
-        problem.gradient(g, elastic, r)
-        lam, _ = problem.multiplier(g, r, open_nodes)
+        _, _, kkt = problem.stationarity(g, problem.local(self.elastic, readonly=True).ravel())
         total, = allsum(problem.mpi, [g.sum()])
-        return problem.natural(g, r, lam), abs(total / problem.n - self.target), True
+        return kkt.natural, abs(total / problem.n - self.target), True
 
     def keep_best(self, x):
         x.copy(self.best_iterate)

@@ -7,7 +7,6 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..contact.certificate import report
-from .objective import QuadraticObjective
 from .options import default_options, set_from_options, stop_subsolver
 from .protocol import Backend, Outcome
 from .registry import register
@@ -128,17 +127,33 @@ class ALMMLoad(MeanConstrainedALMM):
     def __init__(self, problem, control, name, settings):
         self.separation = 0.0
         self.gap_vec = problem.vec()
-        self.objective = QuadraticObjective(problem, increments=False)  # at separation 0: f = p'Kp/2 - p'h
+        # The last point evaluated and its gradient K p - h (the gap at d = 0), for the convergence test.
+        self.point, self.elastic_gap = problem.vec(), problem.vec()
+        self.cached = False
         self.hessian = problem.operator.mat()
         super().__init__(problem, settings, problem.upper_bound, self.hessian)
 
     def evaluate(self, x, gradient):
-        return self.objective.evaluate(x, gradient)
+        """``gradient = K p - h`` (one operator application); returns f = p'Kp/2 - p'h.
+
+        f is evaluated directly, not accumulated from exact increments as the bound types' objective is
+        (:class:`~roughpetsc.solvers.bound_qp.AugmentedQuadratic`): ALMM's augmented-Lagrangian updates use
+        the size of f, and with f measured from the start it took 26272 operator applications instead of
+        14976 (128^2, p* = 0.5, 1e-8).
+        """
+        self.problem.gap(x, 0.0, gradient)
+        x.copy(self.point)
+        if gradient is not self.elastic_gap:
+            gradient.copy(self.elastic_gap)
+        self.cached = True
+        return 0.5 * (x.dot(gradient) - x.dot(self.problem.heights))
 
     def gap_of(self, x):
         """The gap of ``x`` at the separation that zeroes its mean on the contact set (PK's choice)."""
         problem = self.problem
-        elastic_gap = self.objective.gap_of(x)  # K p - h
+        if not (self.cached and x.equal(self.point)):
+            self.evaluate(x, self.elastic_gap)
+        elastic_gap = problem.local(self.elastic_gap, readonly=True)  # K p - h
         self.separation = problem.contact_separation(x, elastic_gap)
         gap = problem.local(self.gap_vec)
         np.add(elastic_gap, self.separation, out=gap)
@@ -153,7 +168,7 @@ class ALMMLoad(MeanConstrainedALMM):
         return kkt.natural, kkt.load_error, True
 
     def prepare(self, pressure):
-        self.objective.restart()
+        self.cached = False
 
     def finish(self, pressure, reason):
         self.gap_of(pressure)
@@ -161,7 +176,7 @@ class ALMMLoad(MeanConstrainedALMM):
 
     def destroy(self):
         super().destroy()
-        for obj in (self.gap_vec, self.objective, self.hessian):
+        for obj in (self.gap_vec, self.point, self.elastic_gap, self.hessian):
             obj.destroy()
 
 

@@ -54,6 +54,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..contact import loops
+from ..elastic.operator import ShellContext
 from ..errors import UserError
 from ..parallel import allmax, allmin, allsum
 from .options import _petsc_library, default_options, set_from_options
@@ -193,16 +194,16 @@ class AugmentedQuadratic:
             v.destroy()
 
 
-class PenalizedCompliance:
+class PenalizedCompliance(ShellContext):
     """MATPYTHON context: the Hessian ``K + c/n 1 1' (+ a I)`` of the augmented Lagrangian (c = 0: K).
 
-    ``shift`` is the BNK family's Hessian perturbation, reset by the owner at each Hessian evaluation.
+    ``perturbation`` a is the BNK family's Hessian shift, reset by the owner at each Hessian evaluation.
     """
 
     def __init__(self, problem):
+        super().__init__(problem.operator)
         self.problem = problem
         self.penalty = 0.0
-        self.perturbation = 0.0
 
     def mult(self, mat, x, y):
         self.problem.operator.displacement(x, y)
@@ -212,14 +213,8 @@ class PenalizedCompliance:
         if self.perturbation:
             y.axpy(self.perturbation, x)
 
-    def multTranspose(self, mat, x, y):
-        self.mult(mat, x, y)
-
     def getDiagonal(self, mat, d):
         d.set(self.problem.operator.diagonal + self.penalty / self.problem.n + self.perturbation)
-
-    def shift(self, mat, a):
-        self.perturbation += a
 
 
 class PenalizedFourier(FourierPreconditioner):
@@ -428,7 +423,7 @@ class BoundQP(Backend):
         self.lower.set(0.0)
         self.upper.set(PETSc.INFINITY if problem.upper_bound is None else problem.upper_bound)
         self.hessian_context = PenalizedCompliance(problem)
-        self.hessian = self._python_mat(self.hessian_context)
+        self.hessian = problem.operator.mat(self.hessian_context)
         self.fourier = self.preconditioning = None
         self.initial_context = self.initial_hessian = None
         self.last = None  # (natural, load error, mean p, separation) of the last iterate tested
@@ -452,7 +447,7 @@ class BoundQP(Backend):
             set_from_options(tao, self.destroy)
         if h0 == "fourier" and tao_type in QUASI_NEWTON_TYPES:
             self.initial_context = FourierInitialHessian(problem, self.objective)
-            self.initial_hessian = self._python_mat(self.initial_context)
+            self.initial_hessian = problem.operator.mat(self.initial_context)
             _set_lmvm_initial_hessian(tao, tao_type, self.initial_hessian)
         self.name = tao.getType() + ("(al)" if control == "load" else "")
 
@@ -485,14 +480,6 @@ class BoundQP(Backend):
             raise UserError(f"{option_name('bound_al_eta', prefix)} must be in [0, 1), got {self.eta}")
         if self.max_outer < 1:
             raise UserError(f"{option_name('bound_al_max_outer', prefix)} must be at least 1, got {self.max_outer}")
-
-    def _python_mat(self, context):
-        n_local = self.problem.vec().getLocalSize()
-        mat = PETSc.Mat().createPython(((n_local, self.problem.n), (n_local, self.problem.n)), context=context,
-                                       comm=self.problem.comm)
-        mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-        mat.setUp()
-        return mat
 
     def _evaluate_hessian(self, tao, x, H, P):
         self.hessian_context.perturbation = 0.0  # a fresh Hessian: BNK's MatShift of the last one is undone
@@ -533,9 +520,9 @@ class BoundQP(Backend):
             test.iteration_offset += self.tao.getIterationNumber()
             reason = self.tao.getConvergedReason()
             if reason > 0 or not restartable(reason, test.watch) or restarts == MAX_RESTARTS \
-                    or not test.best_natural < RESTART_GAIN * floor:
+                    or not test.watch.best_natural < RESTART_GAIN * floor:
                 return iterations, restarts
-            floor = test.best_natural
+            floor = test.watch.best_natural
             restarts += 1
             test.watch.restart(test.iteration_offset - 1)
             self.buffers[self.best].copy(pressure)
@@ -572,7 +559,7 @@ class BoundQP(Backend):
         _set_recycle(self.tao, False)
         iterations, restarts = self._run(pressure, test)
         reason = self.tao.getConvergedReason()
-        if reason < 0 and np.isfinite(test.best_natural):
+        if reason < 0 and np.isfinite(test.watch.best_natural):
             self.buffers[self.best].copy(pressure)
         return Outcome(separation, iterations, describe_stop(reason, test.watch, restarts), history.as_array())
 
@@ -609,10 +596,10 @@ class BoundQP(Backend):
             description = f"CONVERGED_USER ({note})"
         elif test.verdict is Verdict.INNER_DONE:
             description = f"DIVERGED_AL_MAX_OUTER ({note}, best of natural residual, load error " \
-                          f"{test.best_natural:.2g})"
+                          f"{test.watch.best_natural:.2g})"
         else:
             description = describe_stop(reason, test.watch, restarts, load_control=True, note=note)
-        if test.verdict is not Verdict.CONVERGED and np.isfinite(test.best_natural):
+        if test.verdict is not Verdict.CONVERGED and np.isfinite(test.watch.best_natural):
             self.buffers[self.best].copy(pressure)
         return Outcome(separation, iterations, description, history.as_array())
 

@@ -18,7 +18,6 @@ from petsc4py import PETSc
 from ..errors import UserError
 
 
-
 @functools.cache
 def _petsc_library():
     """The PETSc shared library, through petsc4py's extension module (dlsym searches its dependencies)."""

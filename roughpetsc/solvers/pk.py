@@ -29,7 +29,8 @@ class PKBackend(Backend):
     """Polonsky-Keer (projected, preconditioned CG) as a TAO of type ``python`` (so -tao_monitor etc. work).
 
     ``solve(target, pressure, guess)`` takes the scaled mean pressure under load control, the scaled
-    separation under displacement control.
+    separation under displacement control; under displacement control it is also the inner solver of
+    :class:`~roughpetsc.solvers.root_find.RootFind` (``separation``, ``max_seconds``, ``history=``).
 
     Parameters
     ----------
@@ -47,19 +48,29 @@ class PKBackend(Backend):
         self.control = control
         self.context = PolonskyKeer(problem, settings.rule)
         self.prefix = settings.prefix
+        self.max_seconds = settings.rule.max_seconds
         self.tao = python_tao(problem.comm, self.context, settings.prefix)
 
     @property
     def name(self):
         return f"pk({self.context.preconditioner})"
 
+    @property
+    def separation(self):
+        """The separation of the last solve (scaled)."""
+        return self.context.separation
+
     def unusable_options(self):
         """Options given for parts this TAO never runs (line search, KSP, PC, other TAO types): reported unused."""
         return given_but_unusable(PARTS_UNUSED_BY_PYTHON_TAO, self.prefix)
 
-    def solve(self, target, pressure, guess):
-        """Solve for ``target`` from ``pressure`` (overwritten), starting from ``guess.displacement`` if known."""
+    def solve(self, target, pressure, guess=None, history=None):
+        """Solve for ``target`` from ``pressure`` (overwritten), starting from ``guess.displacement`` if known.
+
+        ``history`` (:class:`~roughpetsc.solvers.stopping.History`), if given, receives the residuals too.
+        """
         context = self.context
+        guess = guess or Guess()
         if self.control == "load":
             context.target_pbar, context.target_separation = target, None
         else:
@@ -73,6 +84,8 @@ class PKBackend(Backend):
         finally:
             context.initial_displacement, context.confirm = None, True
         reason = describe_stop(self.tao.getConvergedReason(), context.watch, load_control=self.control == "load")
+        if history is not None:
+            history.extend(context.history.rows)
         return Outcome(context.separation, self.tao.getIterationNumber(), reason, context.history.as_array(),
                        confirmed=not context.unconfirmed)
 
@@ -81,54 +94,21 @@ class PKBackend(Backend):
         self.context.destroy()
 
 
-class PKAtSeparation:
-    """Polonsky-Keer under displacement control, driven by :class:`~roughpetsc.solvers.root_find.RootFind`.
-
-    Under a hardness cap the load is met by a root find on the separation around displacement-controlled
-    PK solves: PK's own load control rescales the pressure to the load after each step, which the cap
-    defeats once the capped nodes carry most of it (measured: stagnation at a load error of 0.4 on the
-    Westergaard wave with H = 1.2 pbar).
-    """
-
-    def __init__(self, problem, settings):
-        self.backend = PKBackend(problem, "displacement", "pk", settings)
-        self.max_seconds = settings.max_seconds
-        self.separation = None
-
-    @property
-    def name(self):
-        return self.backend.name
-
-    @property
-    def tao(self):
-        return self.backend.tao
-
-    def solve(self, separation, pressure, guess=None, history=None):
-        """Solve at ``separation`` (scaled) from ``pressure``; its residuals are added to ``history``."""
-        outcome = self.backend.solve(separation, pressure, Guess())
-        self.separation = separation
-        if history is not None:
-            history.extend(outcome.history)
-        return outcome
-
-    def destroy(self):
-        self.backend.destroy()
-
-
 class CappedPKLoad(Backend):
     """Load control under a hardness cap: PK's own load control, and the root find around PK if that fails.
 
     PK's rescaling to the load works while elastic nodes can take the load that the cap refuses; when
-    the capped nodes carry it nearly all (a fully plastic contact that must grow) it stagnates, and the
-    root find on the separation around displacement-controlled PK (several PK solves) takes over from
-    the start the failed attempt left.
+    the capped nodes carry it nearly all (a fully plastic contact that must grow) it stagnates (measured: at a
+    load error of 0.4 on the Westergaard wave with H = 1.2 pbar), and the root find on the separation around
+    displacement-controlled PK (several PK solves) takes over from the start the failed attempt left.
     """
 
     def __init__(self, problem, control, name, settings):
         self.problem = problem
         self.direct = PKBackend(problem, "load", name, settings)
         try:
-            self.fallback = RootFind(problem, "load", name, settings, inner=PKAtSeparation(problem, settings))
+            inner = PKBackend(problem, "displacement", name, settings)
+            self.fallback = RootFind(problem, "load", name, settings, inner=inner)
         except Exception:
             self.direct.destroy()
             raise

@@ -60,10 +60,6 @@ class PolonskyKeer:
     (displacement control, scaled rigid separation d): then the same projected
     CG runs with d fixed, no mean removal and no rescaling.
 
-    Options (read by :meth:`setFromOptions` under the TAO's prefix): ``-pk_pc none|fourier``,
-    ``-pk_active_set bccg|pk`` and ``-pk_refresh N`` (recompute ``K p`` at
-    least every N iterations).
-
     Parameters
     ----------
     problem : ContactProblem
@@ -95,7 +91,8 @@ class PolonskyKeer:
         self.fourier = FourierPreconditioner(problem)
 
     def setFromOptions(self, tao):
-        """Read ``-pk_pc``, ``-pk_active_set`` and ``-pk_refresh`` under the TAO's options prefix.
+        """Read ``-pk_pc none|fourier``, ``-pk_active_set bccg|pk`` and ``-pk_refresh N`` (recompute ``K p`` at least
+        every N iterations) under the TAO's options prefix.
 
         Called by ``tao.setFromOptions()``. A refused value is kept in :attr:`option_error` (a
         :class:`UserError`) for the caller to raise once ``setFromOptions`` has returned: an

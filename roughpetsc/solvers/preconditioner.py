@@ -95,12 +95,7 @@ class FourierPreconditioner:
         Give it to TAO as the Hessian's preconditioning matrix and set the KSP's
         PC to type ``mat``. Destroy it when done.
         """
-        n_local = self.problem.operator.local_shape[0] * self.problem.operator.local_shape[1]
-        size = ((n_local, self.problem.n), (n_local, self.problem.n))
-        mat = PETSc.Mat().createPython(size, context=_RestrictedMat(self, None), comm=self.problem.comm)
-        mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-        mat.setUp()
-        return mat
+        return self.problem.operator.mat(_RestrictedMat(self, None))
 
 
 class _RestrictedMat:

@@ -36,7 +36,6 @@ given for parts the backend never runs.
 """
 
 from dataclasses import dataclass
-import re
 
 import numpy as np
 
@@ -103,14 +102,6 @@ class BackendSettings:
     rule: StoppingRule
     prefix: str = None
 
-    @property
-    def rtol(self):
-        return self.rule.rtol
-
-    @property
-    def max_seconds(self):
-        return self.rule.max_seconds
-
 
 class Backend:
     """The defaults of the optional parts of the backend protocol; backends may derive from it."""
@@ -126,25 +117,3 @@ class Backend:
     def unusable_options(self):
         return []
 
-
-# The note of describe_stop that quotes the residual of the solver's best iterate.
-BEST_NOTE = re.compile(r"best (of natural residual, load error|natural residual) [^,)]+")
-
-
-def quote_certificate(reason, kkt, load_name="load error"):
-    """``reason`` with its residual note quoting the result as certified (a :class:`~roughpetsc.contact.KKTReport`).
-
-    A solver's own best residual (ALMM's merit, on its cached gradient, of an iterate it may not return) can
-    differ from the certificate of the result, which the output files record: a stop reason quotes the
-    latter, so that the line and the files give the same numbers.
-    """
-    measured = f"natural residual {kkt.natural:.2g}"
-    if kkt.load_error is not None:
-        measured += f", {load_name} {kkt.load_error:.2g}"
-    return BEST_NOTE.sub(measured, reason, count=1)
-
-
-def not_certified(reason, kkt, load_name="load error", gradient="gap"):
-    """The reason of a result whose solver's own test passed but whose certificate did not."""
-    load = "" if kkt.load_error is None else f", {load_name} {kkt.load_error:.2g}"
-    return f"NOT_CERTIFIED ({reason}, but on a fresh {gradient}: natural residual {kkt.natural:.2g}{load})"

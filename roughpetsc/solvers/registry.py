@@ -3,8 +3,8 @@
 The names are those of ``-tao_type`` (and of ``Solver(..., tao_type=...)``): for the elastic contact
 problem the bound-constrained TAO types, ``almm`` and ``pk`` (also ``none``, ``python``, or no name: the
 default); for the adhesive problem ``gapcg`` (the default) and ``almm``. A name may mean a different
-backend under each control (a bound type is the QP itself under displacement control and a root find on
-the separation around it under load control). A new solver or physics registers
+backend under each control (a bound type is the QP itself under displacement control and an augmented
+Lagrangian on the load around it under load control). A new solver or physics registers
 ``register(name, factory, controls, kinds)`` in its own module, imported by :mod:`roughpetsc.solvers`, and
 declares its options in a table (:func:`option_tables`).
 """
@@ -17,93 +17,83 @@ KINDS = ("contact", "adhesive")
 DEFAULT_NAMES = {"contact": "pk", "adhesive": "gapcg"}
 
 
-class Registry:
-    """``(kind, name, control) -> factory(problem, control, name, settings)``, and the option tables of backends."""
+# The one registry of the package, filled by the backend modules when roughpetsc.solvers imports them:
+# (kind, name, control) -> factory(problem, control, name, settings), and backend name -> its option table.
+FACTORIES = {}
+OPTIONS = {}
 
-    def __init__(self):
-        self.factories = {}
-        self.options = {}
 
-    def register(self, name, factory, controls=CONTROLS, kinds=("contact",), options=()):
-        """Make ``factory(problem, control, name, settings)`` the backend of ``name`` for ``kinds`` under ``controls``.
+def register(name, factory, controls=CONTROLS, kinds=("contact",), options=()):
+    """Make ``factory(problem, control, name, settings)`` the backend of ``name`` for ``kinds`` under ``controls``.
 
-        Parameters
-        ----------
-        name : str or sequence of str
-            The name, or the names the factory answers to (it receives the one asked for).
-        factory : callable
-            Returns a backend (:mod:`roughpetsc.solvers.protocol`); ``settings`` is a
-            :class:`~roughpetsc.solvers.protocol.BackendSettings`.
-        controls : sequence of "load", "displacement"
-        kinds : sequence of "contact", "adhesive"
-        options : sequence of (name, default, help)
-            The backend's own options (read under the solver's prefix), for ``-help`` and the check of names.
-        """
-        for control in controls:
-            if control not in CONTROLS:
-                raise ParameterError("controls", f"unknown control '{control}' (one of {', '.join(CONTROLS)})")
-        for kind in kinds:
-            if kind not in KINDS:
-                raise ParameterError("kinds", f"unknown problem kind '{kind}' (one of {', '.join(KINDS)})")
-        names = [name] if isinstance(name, str) else list(name)
-        for alias in names:
-            for kind in kinds:
-                for control in controls:
-                    self.factories[(kind, alias, control)] = factory
-        if options:
-            self.options[names[0]] = list(options)
-
-    def unregister(self, name):
-        """Remove ``name`` (a str or a sequence of them) for every kind and control; unknown names are ignored."""
-        names = [name] if isinstance(name, str) else list(name)
-        for key in [key for key in self.factories if key[1] in names]:
-            del self.factories[key]
-        for alias in names:
-            self.options.pop(alias, None)
-
-    def names(self, control=None, kind="contact"):
-        """The registered names of ``kind`` (under ``control``, or under any), in the order they were registered."""
-        names = [name for k, name, mode in self.factories if k == kind and control in (None, mode)]
-        return list(dict.fromkeys(names))
-
-    def resolve(self, name, control, kind="contact"):
-        """The registered name that ``name`` means for ``kind`` under ``control`` (None or "": the default).
-
-        Raises :class:`~roughpetsc.errors.ParameterError` for ``tao_type`` (an unknown name, or a
-        backend that does not solve ``control``) or ``control``.
-        """
+    Parameters
+    ----------
+    name : str or sequence of str
+        The name, or the names the factory answers to (it receives the one asked for).
+    factory : callable
+        Returns a backend (:mod:`roughpetsc.solvers.protocol`); ``settings`` is a
+        :class:`~roughpetsc.solvers.protocol.BackendSettings`.
+    controls : sequence of "load", "displacement"
+    kinds : sequence of "contact", "adhesive"
+    options : sequence of (name, default, help)
+        The backend's own options (read under the solver's prefix), for ``-help`` and the check of names.
+    """
+    for control in controls:
         if control not in CONTROLS:
-            raise ParameterError("control", f"the control is 'load' or 'displacement', got '{control}'")
-        name = name or DEFAULT_NAMES[kind]
-        if (kind, name, control) in self.factories:
-            return name
-        if name in self.names(kind=kind):
-            other = "load" if control == "displacement" else "displacement"
-            load = "pbar or pstar" if other == "load" else "gbar"
-            raise ParameterError("tao_type", f"the solver {name} solves {other} control only (prescribe {load})")
-        problem = "the contact QP" if kind == "contact" else "the adhesive problem"
-        raise ParameterError("tao_type", f"'{name}' is not a solver of {problem}; use one of "
-                                         f"{', '.join(self.names(kind=kind))}")
-
-    def make(self, problem, control, name, settings):
-        """The backend ``name`` for ``problem`` (its ``kind``) under ``control``, built with ``settings``."""
-        name = self.resolve(name, control, problem.kind)
-        return self.factories[(problem.kind, name, control)](problem, control, name, settings)
+            raise ParameterError("controls", f"unknown control '{control}' (one of {', '.join(CONTROLS)})")
+    for kind in kinds:
+        if kind not in KINDS:
+            raise ParameterError("kinds", f"unknown problem kind '{kind}' (one of {', '.join(KINDS)})")
+    names = [name] if isinstance(name, str) else list(name)
+    for alias in names:
+        for kind in kinds:
+            for control in controls:
+                FACTORIES[(kind, alias, control)] = factory
+    if options:
+        OPTIONS[names[0]] = list(options)
 
 
-# The one registry of the package: backend modules register into it when roughpetsc.solvers imports them.
-BACKENDS = Registry()
-register = BACKENDS.register
-unregister = BACKENDS.unregister
-resolve = BACKENDS.resolve
-make_backend = BACKENDS.make
+def unregister(name):
+    """Remove ``name`` (a str or a sequence of them) for every kind and control; unknown names are ignored."""
+    names = [name] if isinstance(name, str) else list(name)
+    for key in [key for key in FACTORIES if key[1] in names]:
+        del FACTORIES[key]
+    for alias in names:
+        OPTIONS.pop(alias, None)
 
 
 def backend_names(control=None, kind="contact"):
-    """The registered names of ``kind`` (under ``control``, or under any)."""
-    return BACKENDS.names(control, kind)
+    """The registered names of ``kind`` (under ``control``, or under any), in the order they were registered."""
+    names = [name for k, name, mode in FACTORIES if k == kind and control in (None, mode)]
+    return list(dict.fromkeys(names))
+
+
+def resolve(name, control, kind="contact"):
+    """The registered name that ``name`` means for ``kind`` under ``control`` (None or "": the default).
+
+    Raises :class:`~roughpetsc.errors.ParameterError` for ``tao_type`` (an unknown name, or a
+    backend that does not solve ``control``) or ``control``.
+    """
+    if control not in CONTROLS:
+        raise ParameterError("control", f"the control is 'load' or 'displacement', got '{control}'")
+    name = name or DEFAULT_NAMES[kind]
+    if (kind, name, control) in FACTORIES:
+        return name
+    if name in backend_names(kind=kind):
+        other = "load" if control == "displacement" else "displacement"
+        load = "pbar or pstar" if other == "load" else "gbar"
+        raise ParameterError("tao_type", f"the solver {name} solves {other} control only (prescribe {load})")
+    problem = "the contact QP" if kind == "contact" else "the adhesive problem"
+    raise ParameterError("tao_type", f"'{name}' is not a solver of {problem}; use one of "
+                                     f"{', '.join(backend_names(kind=kind))}")
+
+
+def make_backend(problem, control, name, settings):
+    """The backend ``name`` for ``problem`` (its ``kind``) under ``control``, built with ``settings``."""
+    name = resolve(name, control, problem.kind)
+    return FACTORIES[(problem.kind, name, control)](problem, control, name, settings)
 
 
 def option_tables():
     """``{backend name: [(option, default, help), ...]}`` of every registered backend that declares options."""
-    return dict(BACKENDS.options)
+    return dict(OPTIONS)

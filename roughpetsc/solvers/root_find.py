@@ -1,9 +1,8 @@
-"""Load control by a safeguarded root find on the rigid separation around the displacement-controlled QP.
+"""Load control by a safeguarded root find on the rigid separation around the displacement-controlled QP (3.41)-(3.44).
 
-The mean pressure of the solution of (3.41)-(3.44) of the dissertation at a separation d decreases
-monotonically in d; Brent's method finds the d whose mean pressure is the prescribed pbar. The load control of
-the bound types with ``-bound_load rootfind`` (:func:`~roughpetsc.solvers.bound_qp.make_bound`), and of
-Polonsky-Keer under a hardness cap when its own load control fails (:class:`~roughpetsc.solvers.pk.CappedPKLoad`).
+The load control of the bound types with ``-bound_load rootfind`` (:func:`~roughpetsc.solvers.bound_qp.make_bound`),
+and of Polonsky-Keer under a hardness cap when its own load control fails
+(:class:`~roughpetsc.solvers.pk.CappedPKLoad`).
 """
 
 import math
@@ -40,7 +39,7 @@ class RootFind(Backend):
     def __init__(self, problem, control, tao_type, settings, max_evaluations=100, inner=None):
         self.qp = inner or BoundQP(problem, "displacement", tao_type, settings)
         self.problem = problem
-        self.rtol = settings.rtol
+        self.rtol = settings.rule.rtol
         self.max_evaluations = max_evaluations
         self.name = f"rootfind({self.qp.name})"
         self.bracket = {"above": problem.vec(), "below": problem.vec()}  # solutions either side of the load

@@ -24,6 +24,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..errors import UserError
+from ..parallel import allmax
 
 # The iteration limit every TAO of the solvers starts with (-tao_max_it changes it): the natural-residual
 # test decides, and TAO's own limits (the BNK family stops at 50) would end solves early.
@@ -90,11 +91,7 @@ class History:
             return False
         expired = timed and time.perf_counter() - self.start > max_seconds
         asked = self.stop_requested is not None and self.stop_requested()
-        if self.mpi.Get_size() == 1:
-            return expired or asked
-        from mpi4py import MPI
-
-        return bool(self.mpi.allreduce(int((expired and self.mpi.Get_rank() == 0) or asked), op=MPI.MAX))
+        return bool(allmax(self.mpi, [(expired and self.mpi.Get_rank() == 0) or asked])[0])
 
     def as_array(self):
         return np.array(self.rows, dtype=np.float64).reshape(-1, 4)
@@ -181,14 +178,14 @@ class Watch:
         updated one asks for confirmation (``CONFIRM``, nothing recorded) when ``confirm`` is True.
         """
         self.improved = False
+        merit = natural if load_error is None else max(natural, load_error)
         if self.converged(natural, load_error):
             if not fresh and confirm:
                 return Verdict.CONFIRM
             self.history.record(iteration, natural)
-            self.best_natural = natural if load_error is None else max(natural, load_error)
+            self.best_natural = merit
             return Verdict.CONVERGED
         self.history.record(iteration, natural)
-        merit = natural if load_error is None else max(natural, load_error)
         if merit < self.best_natural:
             self.best_natural, self.best_iteration, self.improved = merit, iteration, True
         if self.inner_eta and load_error is not None and natural <= self.inner_eta * load_error:
@@ -225,14 +222,6 @@ class ConvergenceTest:
         self.confirm = confirm
         self.iteration_offset = 0
         self.verdict = Verdict.CONTINUE
-
-    @property
-    def best_natural(self):
-        return self.watch.best_natural
-
-    @property
-    def stopped_by(self):
-        return self.watch.stopped_by
 
     def __call__(self, tao):
         natural, load_error, fresh = self.evaluate(tao)

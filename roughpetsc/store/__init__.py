@@ -2,15 +2,15 @@
 
 File kinds (each module holds its layout, its writer and its reader):
 
-* :mod:`roughpetsc.store.load_path`: ``-mode solve -output``, a load path as its steps finish;
+* :mod:`roughpetsc.store.path_file`: ``-mode solve -output``, a load path as its steps finish;
 * :mod:`roughpetsc.store.stats_file`: ``-mode stats -stats_h5``, surface statistics of one surface or an ensemble;
 * :mod:`roughpetsc.store.ensemble_file`: ``-mode ensemble -output``, BEM solves of many surfaces, resumable.
 
-Every file records the options and versions that made it (:func:`roughpetsc.io.provenance`).
+Every file records the options and versions that made it (:func:`roughpetsc.store.outputs.provenance`).
 
 Writing (:func:`write`): the whole file is built in memory by h5py, then written as bytes to a
 hidden temporary in the target's folder, fsync'ed and renamed over the target
-(:class:`roughpetsc.io.atomic_path` with ``durable=True``). A kill at any moment leaves the previous
+(:class:`roughpetsc.store.outputs.atomic_path` with ``durable=True``). A kill at any moment leaves the previous
 or the new complete file, and a full disk is one plain ``OSError`` of the byte write (HDF5 writing to a
 full disk itself leaves half-closed objects whose clean-up prints tracebacks of its own); the faults
 study (``studies/faults.py``) checks both.

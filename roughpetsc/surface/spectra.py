@@ -141,34 +141,10 @@ def fit_fractal_psd(grid, field, band):
             "rms_log_residual": float(np.sqrt(np.average(residual ** 2, weights=w)))}
 
 
-def spectral_moments_from_power(grid, power, orders=MOMENT_ORDERS):
-    """Directional moments (2.12)-(2.13) as sums over a discrete power spectrum.
-
-    Parameters
-    ----------
-    grid : roughpetsc.surfaces.Grid
-    power : ndarray
-        Output of :func:`power_spectrum` (``rfft2`` layout).
-    orders : sequence of even int
-
-    Returns
-    -------
-    dict ``{"x": {n: m_n0}, "y": {n: m_0n}}``; ``m_n`` in [field]^2 / length^n.
-    The mean (``k = 0``) is excluded, so ``m_0`` is the variance.
-    """
-    k0, k1 = grid.rfft_wavenumbers()
-    power = power.copy()
-    power[0, 0] = 0.0
-    angular = {"x": 2.0 * np.pi * k1, "y": 2.0 * np.pi * k0}
-    moments = {}
-    for direction, w in angular.items():
-        w2 = w ** 2
-        moments[direction] = {n: float(np.sum(power * w2 ** (n // 2))) for n in orders}
-    return moments
-
-
 def spectral_moments(grid, field, orders=MOMENT_ORDERS):
     """Directional spectral moments ``m_n0`` (x) and ``m_0n`` (y) of a periodic field, eq. (2.12)/(2.13).
+
+    Sums over the discrete power spectrum (:func:`power_spectrum`).
 
     Parameters
     ----------
@@ -180,9 +156,18 @@ def spectral_moments(grid, field, orders=MOMENT_ORDERS):
     Returns
     -------
     dict ``{"x": {n: m_n0}, "y": {n: m_0n}}`` in [field]^2 / length^n. Exact
-    for any trigonometric polynomial resolved by the grid.
+    for any trigonometric polynomial resolved by the grid. The mean (``k = 0``) is excluded, so ``m_0``
+    is the variance.
     """
-    return spectral_moments_from_power(grid, power_spectrum(grid, field), orders)
+    k0, k1 = grid.rfft_wavenumbers()
+    power = power_spectrum(grid, field).copy()  # C order (rfft2's is not): the order of the sums below
+    power[0, 0] = 0.0
+    angular = {"x": 2.0 * np.pi * k1, "y": 2.0 * np.pi * k0}
+    moments = {}
+    for direction, w in angular.items():
+        w2 = w ** 2
+        moments[direction] = {n: float(np.sum(power * w2 ** (n // 2))) for n in orders}
+    return moments
 
 
 def fd_derivative(field, spacing, axis, order, scheme=SEED_STENCILS):
