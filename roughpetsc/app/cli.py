@@ -1,7 +1,7 @@
 """The command line: options database in, a run out.
 
     mpiexec -n 2 python -m roughpetsc                     # the embedded default problem
-    mpiexec -n 2 python -m roughpetsc -tao_type bqnls     # load control: root find around BQNLS
+    mpiexec -n 2 python -m roughpetsc -tao_type bqnls     # load control: BQNLS in an augmented Lagrangian
     python -m roughpetsc -pstar_list 0.1,0.5,1 -json out.json -output out.h5
 
 Exit status: 0 success, 2 bad input (one message, no traceback, no output

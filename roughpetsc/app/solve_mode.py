@@ -86,7 +86,8 @@ SOLVER_HELP = """Solvers (PETSc options):
                           (-pk_active_set bccg), preconditioned by the inverse Westergaard symbol (-pk_pc fourier);
                           load control (-pstar/-pbar) or displacement control (-gbar)
   -tao_type <bound type>  blmvm bqnls bncg bqnkls bqnktr bnls bntr tron gpcg: displacement control directly,
-                          load control by a safeguarded root find on the mean gap around that type
+                          load control by an augmented Lagrangian on the mean pressure inside the solve
+                          (-bound_load al), or a safeguarded root find on the mean gap (-bound_load rootfind)
   -tao_type almm          load control by TAO ALMM (-tao_almm_subsolver_tao_type bqnls|blmvm|...)
   with -adhesion          the projected CG on the gap (no -tao_type, or gapcg), or -tao_type almm with the
                           mean-gap equality; displacement control (-gbar, -gbar_list)
