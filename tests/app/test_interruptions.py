@@ -127,13 +127,13 @@ def test_an_interrupted_path_holds_every_step_it_printed(tmp_path, ranks, fields
     assert "Traceback" not in stderr and "PETSC ERROR" not in stderr, stderr
     said = [line for line in stderr.splitlines() if line.startswith("roughpetsc:")]
     steps = saved_steps(tmp_path / "h.h5")
-    if ranks > 1 and not said:
-        # Open MPI's mpiexec stops forwarding the ranks' output once it has the signal and kills them a second
-        # later (odls_base_sigkill_timeout): on a loaded machine the closing line can be lost, never a step,
-        # since every file is replaced atomically.
-        said = [f"roughpetsc: interrupted after {len(steps)} of {len(loads)} step(s) (line lost by mpiexec)"]
-    assert len(said) == 1 and said[0].startswith("roughpetsc: interrupted after "), stderr
-    held = int(said[0].split("after ")[1].split(" of ")[0])
+    if said or ranks == 1:
+        assert len(said) == 1 and said[0].startswith("roughpetsc: interrupted after "), stderr
+        held = int(said[0].split("after ")[1].split(" of ")[0])
+    else:
+        # Open MPI's mpiexec kills the ranks a second after it passes the signal on (odls_base_sigkill_timeout):
+        # on a loaded machine the closing line can be lost, never a step, since every file is replaced atomically.
+        held = len(steps)
     printed = stdout.count("CONVERGED_USER")
     # Once mpiexec has the signal it forwards no more of the ranks' output: rank 0 may have printed more lines.
     assert held == len(steps) >= printed >= 3 and (ranks > 1 or printed == held), (held, printed, len(steps))
