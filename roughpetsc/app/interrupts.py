@@ -7,9 +7,18 @@ one cannot even run Python's handler. So the first signal only sets a flag
 ``-solve_max_time`` (:meth:`roughpetsc.kkt.History.out_of_time`), every rank learns of a request
 made on any rank (:func:`agreed`), and all of them leave the solve by the same iteration. A second
 signal raises ``KeyboardInterrupt`` at once, for a person who does not want to wait.
+
+The run's closing line cannot wait for that safe point: Open MPI's mpiexec kills the ranks one second
+after it passes the signal on, and a rank may spend longer than that in a checkpoint's write (an fsync,
+a collective HDF5 write). So a thread, woken by the signal itself (``signal.set_wakeup_fd``), prints the
+line at once (:meth:`StopRequests.announce_once`), and the files are replaced only through
+:meth:`StopRequests.replace_unless_stopped`: a checkpoint finished after the request is dropped, so the
+line names exactly what the files hold.
 """
 
+import os
 import signal
+import threading
 
 from ..parallel import allmax
 
@@ -20,30 +29,96 @@ class StopRequests:
     """Context manager: inside it SIGINT and SIGTERM set :meth:`is_set` instead of raising.
 
     The handlers in place before are restored on exit. A second signal inside the block raises
-    ``KeyboardInterrupt``.
+    ``KeyboardInterrupt``. ``announcement``, once set, is called once, at the first request, from a
+    thread that does not wait for the main one (:meth:`announce_once`).
     """
 
     def __init__(self):
         self.requested = False
+        self.signals = 0
+        self.announcement = None
+        self.announced = False
+        self.lock = threading.Lock()  # a request comes wholly before or wholly after a replacement of files
         self.previous = {}
+        self.previous_wakeup = -1
+        self.wakeup = self.read_end = None
+        self.watcher = None
 
     def _handle(self, number, frame):
-        if self.requested:
+        self.signals += 1
+        if self.signals > 1:
             raise KeyboardInterrupt
         self.requested = True
+
+    def _watch(self, descriptor):
+        while True:
+            received = os.read(descriptor, 64)
+            if not received:  # closed on exit
+                return
+            if any(number in STOP_SIGNALS for number in received):
+                with self.lock:
+                    self.requested = True
+                self.announce_once()
 
     def is_set(self):
         """True once a signal asked this process to stop."""
         return self.requested
 
+    def announce_once(self):
+        """Call the announcement if a stop was requested and it has not been called (any thread)."""
+        with self.lock:
+            if self.requested and self.announcement is not None and not self.announced:
+                self.announced = True
+                self.announcement()
+
+    def announce_stop(self, announcement):
+        """Take a stop agreed with the other ranks (:func:`agreed`) as this process's own, and announce it
+        (with ``announcement`` if none was set), unless it was announced already."""
+        with self.lock:
+            self.requested = True
+            self.announcement = self.announcement or announcement
+        self.announce_once()
+
+    def replace_unless_stopped(self, replacements, then=None):
+        """Rename finished temporaries over their files and run ``then()``, unless a stop was requested.
+
+        ``replacements``: :class:`roughpetsc.store.outputs.atomic_path` objects whose temporaries
+        are written (``deferred``). A request comes wholly before (the temporaries are removed, the
+        files stay as they were) or wholly after. Returns True if the files were replaced.
+        """
+        try:
+            with self.lock:
+                replaced = not self.requested
+                if replaced:
+                    for replacement in replacements:
+                        replacement.rename()
+                    if then is not None:
+                        then()
+        finally:
+            for replacement in replacements:
+                replacement.discard()  # those not renamed
+        if replaced:
+            for replacement in replacements:
+                replacement.sync_folder()
+        return replaced
+
     def __enter__(self):
         for number in STOP_SIGNALS:
             self.previous[number] = signal.signal(number, self._handle)
+        self.read_end, self.wakeup = os.pipe()
+        os.set_blocking(self.wakeup, False)
+        self.previous_wakeup = signal.set_wakeup_fd(self.wakeup, warn_on_full_buffer=False)
+        self.watcher = threading.Thread(target=self._watch, args=(self.read_end,), name="stop-requests", daemon=True)
+        self.watcher.start()
         return self
 
     def __exit__(self, *exception):
+        signal.set_wakeup_fd(self.previous_wakeup)
         for number, handler in self.previous.items():
             signal.signal(number, handler)
+        os.close(self.wakeup)
+        self.watcher.join()
+        os.close(self.read_end)
         return False
 
 

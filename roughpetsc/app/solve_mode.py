@@ -7,6 +7,7 @@ This module imports PETSc only when it runs (``-help`` prints its table before P
 """
 
 from dataclasses import dataclass, fields
+import functools
 import os
 import sys
 
@@ -374,6 +375,12 @@ def solve_settings(settings, reader, comm, requests):
             start = record.resume_from(settings.output, list(settings.steps), settings.load_option)
             if start is not None:  # the next solve scales it to its load (Solver's warm start)
                 problem.local(solver.pressure)[...] = start[problem.local_rows] / problem.pressure_scale
+        announce = functools.partial(report_interruption, settings, record)
+        if comm.Get_rank() == 0 and (settings.output or settings.json):
+            # Printed as soon as a signal comes: once it is, no file is replaced (StopRequests). Without
+            # files, a step that finishes after the signal is printed, so the line waits for the stop.
+            requests.announcement = announce
+            requests.announce_once()
         say_header(settings, grid, problem, solver, statistics, summary, say)
         if levelling is not None:
             report_levelling(levelling, settings.surface_file, say, comm)
@@ -381,7 +388,7 @@ def solve_settings(settings, reader, comm, requests):
             say(step_line(step) + f"  (from {settings.output})")
         lines = StepLines(say, hold=bool(settings.output or settings.json))
         if solve_path(settings, solver, record, comm, lines, requests, problem.progress):
-            io.on_root(comm, report_interruption, settings, record)
+            io.on_root(comm, requests.announce_stop, announce)
             return 130
         if settings.adhesion is not None:
             adhesive_options.close_cycle(record, lines.add)
@@ -390,8 +397,13 @@ def solve_settings(settings, reader, comm, requests):
             for text in io.on_root(comm, record_stresses, settings, record, grid, whole) or ():
                 lines.add(text)
         if distributed:
-            record.write(settings.output, comm=comm)
-        io.on_root(comm, write_outputs, settings, record, grid, whole, not distributed)
+            replaced = record.write(settings.output, settings.json, comm=comm, requests=requests)
+        else:
+            replaced = io.on_root(comm, record.write, settings.output, settings.json, None, True, requests)
+        if not comm.bcast(replaced, root=0):  # a stop was requested before the files were replaced
+            io.on_root(comm, requests.announce_stop, announce)
+            return 130
+        io.on_root(comm, plot_outputs, settings, record, grid, whole)
         lines.flush()
         return 0 if all(step["converged"] for step in record.steps) else 3
     finally:
@@ -423,7 +435,7 @@ def report_levelling(levelling, path, say, comm):
 
 
 def report_interruption(settings, record):
-    """Rank 0: the one line of an interrupted run, naming what the files hold (nothing is written now)."""
+    """Rank 0: the one line of an interrupted run, naming what the files hold (nothing is written after it)."""
     files = " and ".join(path for path in (settings.output, settings.json) if path)
     held = record.written
     if files and held:
@@ -481,12 +493,11 @@ def record_stresses(settings, record, grid, fields):
             f"{depth.max_location}" for depth in record.stresses]
 
 
-def write_outputs(settings, record, grid, fields, with_h5=True):
-    """The JSON, HDF5 (unless written by every rank) and figure of the run (rank 0; a failure there is every
-    rank's error, io.on_root). ``fields``: the last step's whole fields."""
+def plot_outputs(settings, record, grid, fields):
+    """The figure of the run (rank 0; a failure there is every rank's error, io.on_root). ``fields``: the last
+    step's whole fields."""
     from . import plots
 
-    record.write(settings.output if with_h5 else "", settings.json)
     if settings.plot and not fields:  # every step taken from a file without fields
         print(f"roughpetsc: -plot: no fields to plot in {settings.output} (-output_fields none)", file=sys.stderr)
     elif settings.plot:
@@ -551,7 +562,7 @@ def solve_path(settings, solver, record, comm, lines, requests, progress=None):
         record.add(dict(result.summary(), load_option=kind, load_value=value), result.history, *fields)
         lines.add(step_line(result.summary()))
         # Not before every option is known to be used: a run refused for an unused option writes nothing.
-        if state["checked"] and index < len(steps) - 1 and checkpoint(settings, record, comm):
+        if state["checked"] and index < len(steps) - 1 and checkpoint(settings, record, comm, requests):
             lines.flush()
 
     try:
@@ -562,17 +573,16 @@ def solve_path(settings, solver, record, comm, lines, requests, progress=None):
     return False
 
 
-def checkpoint(settings, record, comm):
+def checkpoint(settings, record, comm, requests):
     """Rewrite the files (-output, -json) with the steps so far when it is time to; True if they were written.
 
-    Every rank takes part: a failed write stops them all. Rank 0's clock decides for all.
+    Every rank takes part: a failed write stops them all. Rank 0's clock decides for all. After a stop
+    request (``requests``, :class:`roughpetsc.app.interrupts.StopRequests`) nothing is written.
     """
     from ..store import outputs as io
 
-    if not (settings.output or settings.json) or not comm.bcast(record.due(), root=0):
+    if not (settings.output or settings.json) or not comm.bcast(record.due() and not requests.is_set(), root=0):
         return False
     if record.first_row is not None:
-        record.write(settings.output, settings.json, comm=comm)
-    else:
-        io.on_root(comm, record.write, settings.output, settings.json)
-    return True
+        return record.write(settings.output, settings.json, comm=comm, requests=requests)
+    return io.on_root(comm, record.write, settings.output, settings.json, None, True, requests)

@@ -30,7 +30,7 @@ import numpy as np
 from .outputs import atomic_path, jsonable
 
 
-def write(path, build):
+def write(path, build, deferred=None):
     """Write an HDF5 file atomically and durably: ``build(h5file)`` fills it in memory first.
 
     Parameters
@@ -39,6 +39,8 @@ def write(path, build):
         The file to create or replace.
     build : callable
         Called with an open, empty, writable ``h5py.File``; whatever it writes is the file.
+    deferred : list, optional
+        The written temporary joins it instead of replacing ``path`` (:class:`roughpetsc.store.outputs.atomic_path`).
 
     Raises :class:`roughpetsc.errors.UserError` naming ``path`` if the file cannot be written.
     """
@@ -47,7 +49,7 @@ def write(path, build):
     image = BytesIO()
     with h5py.File(image, "w") as f:
         build(f)
-    with atomic_path(path, durable=True) as temporary, open(temporary, "wb") as handle:
+    with atomic_path(path, durable=True, deferred=deferred) as temporary, open(temporary, "wb") as handle:
         handle.write(image.getbuffer())
 
 
@@ -58,7 +60,7 @@ def parallel_hdf5(comm):
     return comm is not None and comm.Get_size() > 1 and bool(h5py.get_config().mpi)
 
 
-def write_distributed(path, comm, build, distributed):
+def write_distributed(path, comm, build, distributed, deferred=None):
     """Write an HDF5 file atomically from every rank of ``comm``: :func:`write`, with datasets spread over the ranks.
 
     Parameters
@@ -70,6 +72,8 @@ def write_distributed(path, comm, build, distributed):
         Every rank calls this function (:func:`parallel_hdf5` is True).
     distributed : dict of name -> (local rows, first row)
         Each rank's block of rows of a dataset, written collectively.
+    deferred : list, optional
+        As for :func:`write`, on rank 0.
 
     Raises :class:`roughpetsc.errors.UserError` naming ``path``, on every rank, if the file cannot be written.
     """
@@ -83,7 +87,7 @@ def write_distributed(path, comm, build, distributed):
             image = BytesIO()
             with h5py.File(image, "w") as f:
                 build(f)
-            target = atomic_path(path, durable=True)
+            target = atomic_path(path, durable=True, deferred=deferred)
             temporary = target.__enter__()
             with open(temporary, "wb") as handle:
                 handle.write(image.getbuffer())

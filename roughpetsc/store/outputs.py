@@ -152,13 +152,16 @@ class atomic_path:
 
     The file gets the mode of any new file (:func:`file_mode`; mkstemp's would
     be 0600). ``durable``: fsync the file and its folder, so that a crash right
-    after leaves the old or the new file, whole. A failure to write raises
+    after leaves the old or the new file, whole. ``deferred``: a list; on success the
+    written temporary joins it instead of replacing ``path``, for the caller to :meth:`replace`
+    several files at once (or :meth:`discard` them). A failure to write raises
     :class:`UserError` naming ``path``.
     """
 
-    def __init__(self, path, durable=False):
+    def __init__(self, path, durable=False, deferred=None):
         self.path = path
         self.durable = durable
+        self.deferred = deferred
         folder = os.path.dirname(os.path.abspath(path))
         try:
             handle, self.temporary = tempfile.mkstemp(prefix=".tmp-", suffix=os.path.basename(path), dir=folder)
@@ -175,17 +178,40 @@ class atomic_path:
                 os.chmod(self.temporary, file_mode())
                 if self.durable:
                     _fsync(self.temporary)
-                os.replace(self.temporary, self.path)
-                if self.durable:
-                    _fsync(os.path.dirname(os.path.abspath(self.path)))
+                if self.deferred is None:
+                    self.replace()
+                else:
+                    self.deferred.append(self)
                 return False
             except OSError as error:
                 kind, value = type(error), error
-        if os.path.exists(self.temporary):
-            os.remove(self.temporary)
+        self.discard()
         if issubclass(kind, OSError):  # disk full, permissions changed under the run, ...
             raise UserError(f"cannot write {self.path}: {_os_reason(value)}") from None
         return False
+
+    def replace(self):
+        """:meth:`rename`, then :meth:`sync_folder` (done on exit unless ``deferred``, a list it then joins)."""
+        self.rename()
+        self.sync_folder()
+
+    def rename(self):
+        """Rename the written temporary over the file."""
+        try:
+            os.replace(self.temporary, self.path)
+        except OSError as error:
+            self.discard()
+            raise UserError(f"cannot write {self.path}: {_os_reason(error)}") from None
+
+    def sync_folder(self):
+        """If ``durable``, fsync the folder, so that the rename outlives a crash."""
+        if self.durable:
+            _fsync(os.path.dirname(os.path.abspath(self.path)))
+
+    def discard(self):
+        """Remove the temporary, if it is still there."""
+        if os.path.exists(self.temporary):
+            os.remove(self.temporary)
 
 
 def _os_reason(error):
@@ -234,9 +260,10 @@ def jsonable(value):
     return value
 
 
-def write_json(path, data):
-    """Write ``data`` as indented JSON, atomically (the one JSON writer of every mode)."""
-    with atomic_path(path) as temporary:
+def write_json(path, data, deferred=None):
+    """Write ``data`` as indented JSON, atomically (the one JSON writer of every mode); ``deferred``: as for
+    :class:`atomic_path`."""
+    with atomic_path(path, deferred=deferred) as temporary:
         with open(temporary, "w") as f:
             json.dump(jsonable(data), f, indent=2)
             f.write("\n")

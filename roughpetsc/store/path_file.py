@@ -49,7 +49,8 @@ def _field(group, name, array):
     dataset.attrs.update(DATASET_ATTRIBUTES.get(name, {}))
 
 
-def write(path, summary, fields=None, histories=None, step_fields=None, stresses=(), comm=None, first_row=None):
+def write(path, summary, fields=None, histories=None, step_fields=None, stresses=(), comm=None, first_row=None,
+          deferred=None):
     """Write a load path's file (atomically, :func:`roughpetsc.store.write`).
 
     Parameters
@@ -67,6 +68,8 @@ def write(path, summary, fields=None, histories=None, step_fields=None, stresses
         With ``first_row`` (this rank's first row), the pressure and gap fields of ``fields`` and
         ``step_fields`` are this rank's rows only, and every rank of ``comm`` calls this function: the
         fields are written in parallel (:func:`roughpetsc.store.write_distributed`); ``heights`` is whole.
+    deferred : list, optional
+        The written temporary joins it instead of replacing ``path`` (:func:`roughpetsc.store.write`).
     """
     distributed = {}
     if first_row is not None:
@@ -104,9 +107,9 @@ def write(path, summary, fields=None, histories=None, step_fields=None, stresses
                 _field(group, name, array)
 
     if distributed:
-        write_distributed(path, comm, build, distributed)
+        write_distributed(path, comm, build, distributed, deferred)
     else:
-        write_file(path, build)
+        write_file(path, build, deferred)
 
 
 def read(path):
