@@ -397,9 +397,9 @@ def solve_settings(settings, reader, comm, requests):
             for text in io.on_root(comm, record_stresses, settings, record, grid, whole) or ():
                 lines.add(text)
         if distributed:
-            replaced = record.write(settings.output, settings.json, comm=comm, requests=requests)
+            replaced = record.write(settings.output, settings.json, requests, comm=comm)
         else:
-            replaced = io.on_root(comm, record.write, settings.output, settings.json, None, True, requests)
+            replaced = io.on_root(comm, record.write, settings.output, settings.json, requests)
         if not comm.bcast(replaced, root=0):  # a stop was requested before the files were replaced
             io.on_root(comm, requests.announce_stop, announce)
             return 130
@@ -584,5 +584,5 @@ def checkpoint(settings, record, comm, requests):
     if not (settings.output or settings.json) or not comm.bcast(record.due() and not requests.is_set(), root=0):
         return False
     if record.first_row is not None:
-        return record.write(settings.output, settings.json, comm=comm, requests=requests)
-    return io.on_root(comm, record.write, settings.output, settings.json, None, True, requests)
+        return record.write(settings.output, settings.json, requests, comm=comm)
+    return io.on_root(comm, record.write, settings.output, settings.json, requests)

@@ -66,28 +66,24 @@ class PathRecord:
     def as_summary(self):
         return dict(self.summary, steps=self.steps)
 
-    def write(self, h5_path, json_path=None, comm=None, with_fields=True, requests=None):
-        """Write the files of the steps so far, each atomically; True if they were replaced.
+    def write(self, h5_path, json_path, requests, comm=None):
+        """Write the files of the steps so far, each atomically, and replace them together; True if they were.
 
         On rank 0 alone, or, for a record of distributed fields (``first_row``), on every rank of
-        ``comm`` (the JSON by rank 0). ``with_fields=False`` leaves the pressure and gap fields out
-        (rank 0 alone after an interruption, when the other ranks may not take part). ``requests``:
-        the :class:`roughpetsc.app.interrupts.StopRequests` of the run; the files are then replaced
-        together, and not at all once a stop was requested (what the files hold is what the run's
+        ``comm`` (the JSON by rank 0). ``requests``: the :class:`roughpetsc.app.interrupts.StopRequests`
+        of the run; once a stop was requested no file is replaced (what the files hold is what the run's
         closing line says).
         """
         start = time.perf_counter()
-        distributed = self.first_row is not None and with_fields
-        rank0 = comm is None or comm.Get_rank() == 0
+        distributed = self.first_row is not None
         written = []
         try:
             if h5_path:
-                kept = self.last_fields if self.keep != "none" and with_fields else {}
-                step_fields = self.step_fields if with_fields else {}
+                kept = self.last_fields if self.keep != "none" else {}
                 load_path.write(h5_path, self.as_summary(), dict(heights=self.heights, **kept), self.histories,
-                                step_fields, self.stresses, comm=comm if distributed else None,
-                                first_row=self.first_row if distributed else None, deferred=written)
-            if json_path and rank0:
+                                self.step_fields, self.stresses, comm=comm if distributed else None,
+                                first_row=self.first_row, deferred=written)
+            if json_path and (comm is None or comm.Get_rank() == 0):
                 io.write_json(json_path, self.as_summary(), deferred=written)
         except BaseException:
             for temporary in written:
@@ -98,13 +94,7 @@ class PathRecord:
         def bookkeeping():
             self.written = count
 
-        if requests is None:
-            for temporary in written:
-                temporary.replace()
-            bookkeeping()
-            replaced = True
-        else:
-            replaced = requests.replace_unless_stopped(written, bookkeeping)
+        replaced = requests.replace_unless_stopped(written, bookkeeping)
         self.written_at = time.perf_counter()
         self.write_seconds = self.written_at - start
         return replaced
