@@ -257,11 +257,35 @@ def energies(cases_by_key, ratio, n):
         k = int(np.argmin(p_r))
         pulloff.append(float(p_r[k]))
         edge += k == len(p_r) - 1
-        areas.append(loop_area(c, P_LO))
         pmax = float(c.pstar[c.turn])
+        if not pmax > P_LO:  # the approach closed the contact below P_LO (short_approaches): no loop over the window
+            continue
+        areas.append(loop_area(c, P_LO))
         model_md.append(c.model().dissipated_energy(pmax, P_LO))
         model_jkr.append(c.model("jkr").dissipated_energy(pmax, P_LO))
     return mean_sd_se(pulloff), edge, mean_sd_se(areas), mean_sd_se(model_md), mean_sd_se(model_jkr)
+
+
+def short_approaches(cases, pmax):
+    """Lines on the partial cycles whose approach turned before p*max: the contact closed, the mean gap fell below
+    the protocol's smallest (``SMALLEST_GAP`` of adhesion_rough_cycles.py, where it turns too), and the mean
+    pressure fell, the adhesive stress holding the contact closed."""
+    lines = []
+    for c in cases:
+        if c.protocol != "partial" or c.pstar[c.turn] >= pmax:
+            continue
+        top = int(np.argmax(c.pstar[:c.turn + 1]))
+        lines.append(f"- surface {c.seed} at 1/{c.ratio:g}, N = {c.n}: the approach reached p* = "
+                     f"{c.pstar[top]:.3g} (g* {c.gstar[top]:.3g}), then p* fell to {c.pstar[c.turn]:.3g} as g* went "
+                     f"to {c.gstar[c.turn]:.2g} with {round(c.non_contact[c.turn] * c.n ** 2)} non-contact node(s) "
+                     "left: the adhesive stress holds the contact closed under a tensile mean pressure. The "
+                     "retraction starts there. The path enters the tables at the p* it passes; its loop area over "
+                     f"p* >= {P_LO:g} and the model's are left out when it turned below {P_LO:g}.")
+    if not lines:
+        return []
+    return ["## Approaches that closed the contact before p*max", "",
+            f"These partial cycles turned before reaching p*max = {pmax:g}, when g* fell below the protocol's smallest "
+            "gap:", ""] + lines + [""]
 
 
 def folds(grouped):
@@ -565,6 +589,7 @@ def report(group=1, pmax=2.0):
     error_rows = {key: model_errors(grouped, *key, numbers=numbers[key]) for key in numbers}
     energy = {key: energies(grouped, *key) for key in grouped}
     lines += provisional_reading(numbers, have, energy, grouped)
+    lines += short_approaches(cases, pmax)
     lines += ["## Grid convergence at a fixed mean gap (approach)", "",
               "Mean over the surfaces every grid has (± standard error); the gaps are those of the path nearest the "
               "finest grid's first passage through p* = 0.5, 1, 1.5, 2. Changes are relative, from one grid to the "
@@ -611,7 +636,8 @@ def report(group=1, pmax=2.0):
                 for c, f in pairs:
                     pull = [float(np.min(x.part(-1)[1])) for x in (c, f)]
                     area = [loop_area(x, P_LO) for x in (c, f)]
-                    rows.append([c.seed, f"{pull[0]:+.3f}", f"{pull[1]:+.3f}", fmt(area[0]), fmt(area[1]),
+                    rows.append([c.seed, f"{pull[0]:+.3f}", f"{pull[1]:+.3f}",
+                                 *(fmt(a) if a is not None else "-" for a in area),
                                  f"{(area[1] - area[0]) / area[0]:+.0%}" if None not in area and area[0] else "-"])
                 lines += [f"The same surfaces' least retraction p* (within g* <= 0.6) and loop area over p* >= "
                           f"{P_LO:g} on both grids (1/{ratio:g}):", "",
