@@ -56,9 +56,7 @@ class StopRequests:
             if not received:  # closed on exit
                 return
             if any(number in STOP_SIGNALS for number in received):
-                with self.lock:
-                    self.requested = True
-                self.announce_once()
+                self.request_stop()
 
     def is_set(self):
         """True once a signal asked this process to stop."""
@@ -71,9 +69,9 @@ class StopRequests:
                 self.announced = True
                 self.announcement()
 
-    def announce_stop(self, announcement):
-        """Take a stop agreed with the other ranks (:func:`agreed`) as this process's own, and announce it
-        (with ``announcement`` if none was set), unless it was announced already."""
+    def request_stop(self, announcement=None):
+        """Record a stop request (a signal, or a stop agreed with the other ranks, :func:`agreed`) and announce
+        it (with ``announcement`` if none was set), unless it was announced already."""
         with self.lock:
             self.requested = True
             self.announcement = self.announcement or announcement

@@ -388,7 +388,7 @@ def solve_settings(settings, reader, comm, requests):
             say(step_line(step) + f"  (from {settings.output})")
         lines = StepLines(say, hold=bool(settings.output or settings.json))
         if solve_path(settings, solver, record, comm, lines, requests, problem.progress):
-            io.on_root(comm, requests.announce_stop, announce)
+            io.on_root(comm, requests.request_stop, announce)
             return 130
         if settings.adhesion is not None:
             adhesive_options.close_cycle(record, lines.add)
@@ -396,12 +396,8 @@ def solve_settings(settings, reader, comm, requests):
         if settings.stress_depths:
             for text in io.on_root(comm, record_stresses, settings, record, grid, whole) or ():
                 lines.add(text)
-        if distributed:
-            replaced = record.write(settings.output, settings.json, requests, comm=comm)
-        else:
-            replaced = io.on_root(comm, record.write, settings.output, settings.json, requests)
-        if not comm.bcast(replaced, root=0):  # a stop was requested before the files were replaced
-            io.on_root(comm, requests.announce_stop, announce)
+        if not write_files(settings, record, comm, requests):  # a stop was requested before they were replaced
+            io.on_root(comm, requests.request_stop, announce)
             return 130
         io.on_root(comm, plot_outputs, settings, record, grid, whole)
         lines.flush()
@@ -579,10 +575,18 @@ def checkpoint(settings, record, comm, requests):
     Every rank takes part: a failed write stops them all. Rank 0's clock decides for all. After a stop
     request (``requests``, :class:`roughpetsc.app.interrupts.StopRequests`) nothing is written.
     """
-    from ..store import outputs as io
-
     if not (settings.output or settings.json) or not comm.bcast(record.due() and not requests.is_set(), root=0):
         return False
+    return write_files(settings, record, comm, requests)
+
+
+def write_files(settings, record, comm, requests):
+    """Write -output and -json with the steps so far, by every rank where each writes its rows of the fields,
+    else by rank 0; True on every rank if the files were replaced (not after a stop request, ``requests``)."""
+    from ..store import outputs as io
+
     if record.first_row is not None:
-        return record.write(settings.output, settings.json, requests, comm=comm)
-    return io.on_root(comm, record.write, settings.output, settings.json, requests)
+        replaced = record.write(settings.output, settings.json, requests, comm=comm)
+    else:
+        replaced = io.on_root(comm, record.write, settings.output, settings.json, requests)
+    return comm.bcast(replaced, root=0)

@@ -167,7 +167,8 @@ def test_a_stop_request_is_announced_at_once_and_no_file_is_replaced_after_it(tm
         assert not requests.replace_unless_stopped(written, then=pytest.fail)
     assert sorted(os.listdir(tmp_path)) == ["a.h5", "a.json"]  # no temporary left
     assert all((tmp_path / name).read_text() == "old" for name in ("a.h5", "a.json"))
-    os.close(blocked), os.close(release)
+    os.close(blocked)
+    os.close(release)
 
 
 def test_files_are_replaced_together_without_a_stop_request(tmp_path):
@@ -180,6 +181,7 @@ def test_files_are_replaced_together_without_a_stop_request(tmp_path):
             with atomic_path(tmp_path / name, deferred=written) as temporary:
                 open(temporary, "w").write("new")
         assert sorted(os.listdir(tmp_path))[0].startswith(".tmp-")  # nothing replaced yet
+        assert not any((tmp_path / name).exists() for name in ("a.h5", "a.json"))
         assert requests.replace_unless_stopped(written, then=lambda: done.append(1)) and done == [1]
     assert sorted(os.listdir(tmp_path)) == ["a.h5", "a.json"]
     assert all((tmp_path / name).read_text() == "new" for name in ("a.h5", "a.json"))
