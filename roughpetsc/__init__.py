@@ -19,13 +19,8 @@ neither numpy nor PETSc, so the command line can hand PETSc its options
 statistics and model parts never import PETSc; ``ContactProblem``, ``Solver`` and
 ``load_path`` do (call ``petsc4py.init(args)`` first to give PETSc options).
 
-One thread per MPI rank: unless the environment says otherwise, the BLAS and
-OpenMP thread pools are limited to one thread before numpy loads them (this
-takes effect when roughpetsc is imported before numpy, as ``python -m
-roughpetsc`` does). A threaded BLAS splits our long dot products over the
-cores that the other ranks need: on 2 cores it made one 512^2 load history
-11 % slower alone and two of them side by side 40 % slower. FFTW's threads
-are an option of their own (``-fft_threads``).
+One thread per MPI rank: the BLAS and OpenMP pools are limited to one thread before numpy loads them,
+unless the environment says otherwise (docs/runtime.md).
 """
 
 import os

@@ -1,19 +1,7 @@
 """Ctrl-C and a batch system's SIGTERM as a request to stop at the next safe point, on every rank alike.
 
-Raising ``KeyboardInterrupt`` wherever the signal lands cannot end a run on several ranks cleanly: a
-rank that leaves its solve strands the others in their next collective call, and a rank blocked in
-one cannot even run Python's handler. So the first signal only sets a flag
-(:class:`StopRequests`); the solvers look at it in the collective check that also enforces
-``-solve_max_time`` (:meth:`roughpetsc.kkt.History.out_of_time`), every rank learns of a request
-made on any rank (:func:`agreed`), and all of them leave the solve by the same iteration. A second
-signal raises ``KeyboardInterrupt`` at once, for a person who does not want to wait.
-
-The run's closing line cannot wait for that safe point: Open MPI's mpiexec kills the ranks one second
-after it passes the signal on, and a rank may spend longer than that in a checkpoint's write (an fsync,
-a collective HDF5 write). So a thread, woken by the signal itself (``signal.set_wakeup_fd``), prints the
-line at once (:meth:`StopRequests.announce_once`), and the files are replaced only through
-:meth:`StopRequests.replace_unless_stopped`: a checkpoint finished after the request is dropped, so the
-line names exactly what the files hold.
+The first signal sets a flag that every rank checks at the same safe point (:func:`agreed`); a second raises
+``KeyboardInterrupt``; a thread prints the closing line at once. Why: docs/runtime.md.
 """
 
 import os

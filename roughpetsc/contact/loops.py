@@ -3,16 +3,10 @@
 residual of the adhesive certificate, and the callbacks of TAO's bound types (:mod:`~roughpetsc.solvers.bound_qp`:
 objective and gradient, convergence test, initial Hessian).
 
-Between two reductions over the ranks (or two FFTs) an iteration makes several passes over the local
-arrays; as numpy calls each is a sweep of its own through memory, and at 1024^2 those sweeps took more
-time than the iteration's two FFT pairs. Each function here is one compiled loop (numba) over the local
-flat arrays that does a whole stretch of the iteration and returns its local sums, so an iteration sweeps
-the memory about ten times instead of fifty. The arithmetic is that of the numpy version node by node; the
-sums may be reassociated (``fastmath={"reassoc"}``, so that they vectorise): their order is not numpy's.
-
-The hardness cap enters as ``upper`` (``inf`` without one): a node is capped when ``p >= upper``, and the
-arithmetic with ``inf`` reduces every test to the uncapped one. Masks are 0.0/1.0 float arrays (``contact``,
-``free``) or boolean arrays (``open_nodes``).
+Each function is one compiled loop (numba) over the local flat arrays (why: docs/solvers.md). The hardness
+cap enters as ``upper`` (``inf`` without one): a node is capped when ``p >= upper``, and the arithmetic with
+``inf`` reduces every test to the uncapped one. Masks are 0.0/1.0 float arrays (``contact``, ``free``) or
+boolean arrays (``open_nodes``).
 """
 
 from numba import njit

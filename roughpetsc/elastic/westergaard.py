@@ -4,14 +4,8 @@
 displacement (the mean pressure only moves the body rigidly; docs/conventions.md),
 so the mean of ``w`` is zero and the mean gap equals the rigid separation (3.38).
 
-One rank: a direct 2-D FFTW plan (pyFFTW, r2c and c2r, built once with
-``FFTW_MEASURE``) that reads the input Vec's memory and writes the output Vec's
-memory in place: one r2c, one pointwise product, one c2r per application and no
-N^2 copy. Several ranks: the slab transform of :mod:`roughpetsc.slab` (rows of
-the real array distributed like PETSc's ownership ranges; on one node the half
-spectrum lives in an MPI-3 shared window, so there is no transpose copy). It
-replaced mpi4py-fft's PFFT, which was 3.5x slower on 2 ranks here
-(studies/output/mpi_speedup.md; the study builds that PFFT pair itself).
+One rank: a direct 2-D FFTW plan in place on the Vecs' memory; several ranks: the slab transform of
+:mod:`roughpetsc.slab` (docs/runtime.md).
 """
 
 import numpy as np

@@ -1,22 +1,7 @@
 """FFTW planning: the planner effort and the wisdom that makes a run repeatable.
 
-FFTW_MEASURE and FFTW_PATIENT choose among algorithms by timing them, so two
-runs of the same command may transform with different algorithms, whose
-results differ in the last bits; an iterative solver amplifies that into
-different iterate sequences (BLMVM on 2 ranks took 533 to 1067 iterations from
-one command). FFTW_ESTIMATE plans by a fixed rule and is repeatable, but it is
-1.5x slower per transform at N >= 1024 here.
-
-So plans of MEASURE or higher effort are remembered: a run imports the wisdom
-of the cache file (``-fft_wisdom PATH``; by default one file per CPU model in
-``$XDG_CACHE_HOME/roughpetsc`` or ``~/.cache/roughpetsc``), and adds to it the
-plans it had to measure. The first run of a grid on a machine measures; every
-later run of that grid reuses those plans and repeats its iterates exactly.
-
-``ROUGHPETSC_FFT_EFFORT`` in the environment overrides every planner effort a
-caller asks for (the test suite runs whole under ESTIMATE, MEASURE and
-PATIENT that way); ``ROUGHPETSC_FFT_WISDOM`` overrides the cache file
-(``none``: no cache).
+Wisdom cache ``-fft_wisdom``; ``ROUGHPETSC_FFT_EFFORT`` and ``ROUGHPETSC_FFT_WISDOM`` in the environment
+override the effort and the cache. Why, and what it costs: docs/runtime.md.
 """
 
 from contextlib import contextmanager

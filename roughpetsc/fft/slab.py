@@ -1,33 +1,7 @@
 """A hand-written slab-decomposed 2-D real FFT pair for several MPI ranks.
 
-Real space: each rank owns a block of rows (``local_rows``), as many as
-possible equal: the first ``n0 % size`` ranks get one extra row, the split of
-PETSc's ``PETSC_DECIDE`` (:func:`row_split`); the Vecs are created with these
-blocks as explicit local sizes, so PETSc's ownership ranges are exactly the row
-blocks. Spectral space: each rank owns a block of columns of the full ``rfft2``
-spectrum, all rows, stored like the full spectrum (not transposed):
-``spectral_slice = (slice(None), slice(c0, c1))``. The ``n1 // 2 + 1`` spectral
-columns are split the same way (:func:`block_split`).
-
-The forward pass is a batched 1-D r2c along axis 1 over the local rows, an
-exchange, and a batched 1-D c2c along axis 0 over the local columns; the
-inverse pass runs backwards. All plans are pyFFTW plans made once
-(``FFTW_MEASURE`` by default) on SIMD-aligned buffers.
-
-Two exchanges:
-
-``shared`` (default when all ranks share one node's memory, MPI-3 shared
-    window): the whole ``(n0, n1 // 2 + 1)`` half spectrum lives in one shared
-    segment. Each rank's r2c writes its rows into it, a barrier, and each
-    rank's c2c plans run in place on its columns of that same array. There is
-    no transpose copy at all: the memory traffic is that of a serial 2-D FFT,
-    split over the ranks, plus two barriers per pair.
-``alltoall`` (any layout of ranks): the r2c output is packed into contiguous
-    per-destination blocks (one numpy copy) and exchanged with
-    ``MPI_Alltoallv``; received blocks are already the rows of the local
-    column slab (rank ``p``'s block lands at its first row ``row_starts[p]``).
-    The inverse exchange sends contiguous row blocks and unpacks into the r2c
-    layout (one copy).
+Rows of the real array and columns of the half spectrum dealt to the ranks; exchanges ``shared`` (an
+MPI-3 shared window) and ``alltoall``. The layout and the two exchanges: docs/runtime.md.
 """
 
 import numpy as np

@@ -5,27 +5,8 @@ Dimensionless groups of Eqs. (6.4)-(6.6): ``p* = p0 / P``, ``b* = b / L``,
 ``sigma0* = sigma0 / P`` with ``P = (pi^2 E*^2 w^2 kappa / 72)^(1/5)`` and
 ``L = (81 pi E* w / (16 kappa^2))^(1/5)``.
 
-Maugis-Dugdale solution set.  Eliminating p* between (6.28) and (6.29) gives,
-with s = sqrt(1 - m^2),
-
-    s^3 b^3 + sigma0 m (1 - m) b - 1/sigma0 = 0,    p = 3/2 b^2 + sigma0 s,
-
-whose positive root b(m) is unique for every m in [0, 1): the whole solution
-set is one curve parametrised by m, from F (m = 0, (6.39)) to the JKR-like end
-A (m -> 1, b -> inf).  Its minimum in p* is the snap-in point B; the stable
-branch is the part beyond B (checked against (6.31) in the tests).
-
-Trapped volume: integrating the crack opening (6.24) over the crack gives
-V* = 2 pi b^3 [p - 9/10 b^2 - sigma0 (1 - m^2)^(3/2)] in closed form (the
-adhesive term is int_c^b 2 pi t sqrt(t^2 - c^2) dt); the printed (6.33)/(6.35)
-differ from it (see the study notes).
-
-JKR limit.  As sigma0 -> inf at a fixed surface energy w, sigma0* -> inf while the scales P, L of (6.4)
-stay, the cohesive zone vanishes (m -> 1), the stable branch tends to (6.14), the snap-in point B to
-(6.15), and E (6.38) and F (6.39) recede to infinity: a crack closed on loading never reopens
-(:class:`JKRCrack`).  ``AdhesiveGW(..., crack_law="jkr")`` is the rough model built on it, the model
-with loading-unloading hysteresis in the JKR limit that section 6.6 draws beside the Maugis-Dugdale one
-(Figs. 6.9-6.10, "calculated based on the work of Ciavarella et al.").
+The Maugis-Dugdale solution set as one curve in m, the closed-form trapped volume and the JKR limit
+(:class:`JKRCrack`, ``AdhesiveGW(..., crack_law="jkr")``): docs/models.md.
 """
 
 import numpy as np
@@ -103,7 +84,7 @@ def jkr_volume(b, p):
 class JKRCrack:
     """Penny-shaped adhesive crack in the JKR limit, Eqs. (6.11)-(6.21), with its load history.
 
-    The limit sigma0* -> inf of :class:`AdhesiveCrack` at a fixed w (module docstring): the same
+    The limit sigma0* -> inf of :class:`AdhesiveCrack` at a fixed w (docs/models.md): the same
     interface (``points``, ``breakpoints``, ``state``, ``area``, ``volume``), with m = c / b = 1 (no
     cohesive zone) and ``sigma = inf``.
 
@@ -314,7 +295,7 @@ class AdhesiveCrack:
         return np.pi * np.asarray(b) ** 2
 
     def volume(self, p, b, m):
-        """Trapped volume V* of (6.24) integrated in closed form (see module doc)."""
+        """Trapped volume V* of (6.24) integrated in closed form (docs/models.md)."""
         return 2.0 * np.pi * b ** 3 * (p - 0.9 * b ** 2 - self.sigma * (1.0 - m * m) ** 1.5)
 
     def G(self, p, b, m):

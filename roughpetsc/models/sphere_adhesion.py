@@ -10,46 +10,8 @@ Units: lengths ``a``, ``c``, ``R`` [length], approach ``delta`` [length]
 ``sigma0`` [pressure], ``w`` [energy/area = pressure * length], loads ``P``
 [force], positive compressive.
 
-Sources
--------
-[JKR]  K. L. Johnson, K. Kendall, A. D. Roberts, Proc. R. Soc. Lond. A 324
-       (1971) 301-313; in the form of K. L. Johnson, *Contact Mechanics*
-       (CUP 1985), section 5.5, with K = 4 E*/3 (equation numbers of the book
-       not checked here).
-[DMT]  B. V. Derjaguin, V. M. Muller, Yu. P. Toporov, J. Colloid Interface
-       Sci. 53 (1975) 314-326.
-[M92]  D. Maugis, J. Colloid Interface Sci. 150 (1992) 243-269: Eq. (6.17)
-       is the cohesive-zone equation (numbering as quoted by the
-       ContactEngineering/Adhesion reference code; the load and penetration
-       equations are those printed with it; the original was not at hand).
-[JG97] K. L. Johnson, J. A. Greenwood, J. Colloid Interface Sci. 192 (1997)
-       326-333 (same equations and the adhesion map).
-
-Maugis-Dugdale in the notation of [M92]/[JG97]
------------------------------------------------
-K = 4 E*/3;  scales  a_s = (pi w R^2 / K)^(1/3),  P_s = pi w R,
-d_s = (pi^2 w^2 R / K^2)^(1/3);  A = a / a_s,  Pbar = P / P_s,
-Delta = delta / d_s,  m = c / a (c = outer radius of the Dugdale zone),
-h0 = w / sigma0 (range of the Dugdale law),
-
-    lambda = 2 sigma0 (R / (pi w K^2))^(1/3) = sigma0 (9 R / (2 pi w E*^2))^(1/3),
-
-and with mu = sqrt(m^2 - 1)
-
-    (lambda A^2 / 2) [mu + (m^2 - 2) arctan mu]
-        + (4 lambda^2 A / 3) [mu arctan mu - m + 1] = 1          [M92 (6.17)]
-    Pbar  = A^3 - lambda A^2 [mu + m^2 arctan mu]
-    Delta = A^2 - (4/3) lambda A mu.
-
-In physical units: P = K a^3/R - 2 sigma0 [a sqrt(c^2 - a^2) + c^2 arccos(a/c)],
-delta = a^2/R - 2 sigma0 sqrt(c^2 - a^2) / E*.  The contact pressure is
-(2 E* a/(pi R)) sqrt(1 - r^2/a^2) - (2 sigma0/pi) arctan sqrt((c^2-a^2)/(a^2-r^2))
-for r < a and -sigma0 for a < r < c.  lambda -> 0 gives DMT (Pbar = A^3 - 2,
-Delta = A^2), lambda -> inf gives JKR (Pbar = A^3 - sqrt(6 A^3),
-Delta = A^2 - (2/3) sqrt(6 A)).  lambda relates to the Tabor parameter
-mu_T = (R w^2 / (E*^2 z0^3))^(1/3) by lambda = 1.1570 mu_T when sigma0 is the
-Lennard-Jones maximum stress 16 w/(9 sqrt(3) z0) ([JG97]; 1.1570 =
-16/(9 sqrt 3) (9/(2 pi))^(1/3)).
+Sources ([JKR], [DMT], [M92], [JG97]) and the Maugis-Dugdale equations in the notation of [M92]/[JG97]
+(scales a_s, P_s, d_s; lambda; [M92] (6.17)): docs/models.md.
 """
 
 import numpy as np

@@ -1,41 +1,8 @@
 """Polonsky-Keer constrained conjugate gradients, the context of a TAO of type ``python``.
 
-Polonsky and Keer, Wear 231 (1999): CG on the contact set with the mean gap
-there removed (which fixes the rigid separation), projection onto p >= 0 and
-rescaling to the prescribed mean pressure after each step. Under displacement
-control (d prescribed) the same projected CG runs with d fixed and without
-the rescaling.
-
-Active-set strategy (``-pk_active_set``):
-
-- ``bccg`` (the default): the bound-constrained CG of Vollebregt (J. Optim.
-  Theory Appl. 162, 2014). The free set is the contact set plus the nodes out
-  of contact whose gap is negative, so the search direction itself pushes
-  overlapping nodes into contact; steps crossing p = 0 are truncated by the
-  projection, and CG continues with the Polak-Ribiere beta (clipped at 0)
-  instead of restarting.
-- ``pk``: as published. Overlapping nodes enter with p = -step g after the
-  step and CG restarts whenever any did; the contact set grows by a rim of
-  nodes per restart, which is what makes PK slow to find it.
-
-Preconditioning (``-pk_pc fourier``, the default): plain PK needs O(N)
-iterations because K is ill-conditioned on the contact set; the search
-direction is built from ``z = B r`` instead of the residual ``r``, with ``B``
-the Fourier preconditioner of :mod:`roughpetsc.preconditioner` (preconditioned
-CG on the free set, as Vollebregt, J. Comput. Phys. 257, 2014, without his
-deflation). It costs one more FFT pair per iteration. ``-pk_pc none
--pk_active_set pk`` is the published algorithm.
-
-Operator applications: the step needs ``K t``; the gap of the new iterate is
-then updated as ``K p <- s (K p - step K t)`` whenever the projection (and,
-under PK, the entry of nodes) changed nothing, and recomputed with a fresh
-``K p`` otherwise, every ``-pk_refresh`` iterations, and before convergence is
-declared (the stopping rule is always checked on a freshly computed gap).
-
-The stopping rule is the natural KKT residual of :mod:`roughpetsc.kkt` (docs/conventions.md).
-``tao.monitor`` is called every iteration so that ``-tao_monitor`` and Python
-monitors work. The backend that drives this context along load paths is
-:mod:`roughpetsc.solvers.pk`.
+Polonsky and Keer, Wear 231 (1999), with Vollebregt's bound-constrained active set (``-pk_active_set bccg``)
+and the Fourier preconditioner (``-pk_pc fourier``); the backend that drives it along load paths is
+:mod:`roughpetsc.solvers.pk`. The algorithm, its options and its operator applications: docs/solvers.md.
 """
 
 import numpy as np

@@ -1,21 +1,7 @@
 """The Fourier preconditioner of the contact QP on its free (contact) set.
 
-The compliance K has the symbol 1/(pi E* |k|) (the Westergaard operator (3.33)
-of the dissertation), so its condition number on the contact set C grows like
-N. Its inverse symbol pi E* |k|, applied in Fourier space to a residual that
-vanishes off C and restricted to C again, is a cheap approximate inverse of
-K_CC (Vollebregt, J. Comput. Phys. 257, 2014): one FFT pair per application.
-
-``B r = P S P r + w mean_C(r) / lambda_C 1_C`` with ``S`` the inverse symbol,
-``P`` the removal of the mean on C, and ``lambda_C = <1_C, K 1_C> / |C|`` the
-compliance of a uniform pressure on C. The second term preconditions the mean
-on C, which the symbol (whose k = 0 mode is the rigid body) cannot; it is
-dropped under load control, where the mean pressure is fixed. ``B`` is
-symmetric positive definite on C (a sum over two orthogonal subspaces).
-
-Used by Polonsky-Keer (:mod:`roughpetsc.solvers.polonsky_keer`) and, as a Hessian
-preconditioning matrix with a free-set ``createSubMatrix`` and PC type
-``mat``, by TAO's TRON, GPCG and BNK types.
+``B r = P S P r + w mean_C(r) / lambda_C 1_C`` (Vollebregt, J. Comput. Phys. 257, 2014), used by
+Polonsky-Keer and, as a Hessian preconditioning matrix, by TRON, GPCG and BNK: docs/solvers.md.
 """
 
 import numpy as np

@@ -8,18 +8,8 @@ File kinds (each module holds its layout, its writer and its reader):
 
 Every file records the options and versions that made it (:func:`roughpetsc.store.outputs.provenance`).
 
-Writing (:func:`write`): the whole file is built in memory by h5py, then written as bytes to a
-hidden temporary in the target's folder, fsync'ed and renamed over the target
-(:class:`roughpetsc.store.outputs.atomic_path` with ``durable=True``). A kill at any moment leaves the previous
-or the new complete file, and a full disk is one plain ``OSError`` of the byte write (HDF5 writing to a
-full disk itself leaves half-closed objects whose clean-up prints tracebacks of its own); the faults
-study (``studies/faults.py``) checks both.
-
-Parallel HDF5 (:func:`write_distributed`): where h5py is the parallel build (Debian's h5py takes it
-under mpiexec: ``h5py.get_config().mpi``), the field datasets of a load path, the only large part of
-any file, are written by every rank into its own rows (``driver="mpio"``, collective I/O) after rank 0
-has written the rest of the file, with those datasets created empty, to the temporary; rank 0 then
-renames it. Everything else is written by rank 0.
+Writing: atomically, by :func:`write` (rank 0) or :func:`write_distributed` (every rank its rows of the
+fields, parallel HDF5); how, and why: docs/runtime.md.
 """
 
 from io import BytesIO
