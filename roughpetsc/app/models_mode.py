@@ -4,7 +4,7 @@ Options are read only through ``PETSc.Options`` getters so that PETSc's
 ``-options_left`` reports unused or misspelled ones.
 """
 
-from dataclasses import dataclass
+from dataclasses import make_dataclass
 import json
 
 import numpy as np
@@ -32,23 +32,9 @@ OPTIONS = [
 ]
 
 
-@dataclass(frozen=True)
-class ModelsSettings:
-    """What ``-mode models`` was asked to do; fields are named as the options of :data:`OPTIONS` are."""
-
-    models_alpha_h: float
-    models_alpha_p: float
-    models_n: int
-    models_dmax: float
-    models_pmax: float
-    models_kl: float
-    models_ks: float
-    models_hurst: float
-    models_m2: float
-    models_group: int
-    models_curvefit_model: str
-    models_json: str
-    models_plot: str
+# What ``-mode models`` was asked to do; fields are named as the options of OPTIONS are.
+ModelsSettings = make_dataclass("ModelsSettings", [(name, type(default)) for name, default, _ in OPTIONS],
+                                frozen=True)
 
 
 def read_settings(options):

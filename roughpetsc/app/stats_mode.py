@@ -54,9 +54,7 @@ OPTIONS = [
 PDF_RANGE = (-5.0, 5.0)
 
 
-# ----------------------------------------------------------------------------
-# Options
-# ----------------------------------------------------------------------------
+# --- Options
 
 @dataclass(frozen=True)
 class StatsSettings:
@@ -133,9 +131,7 @@ def histogram_edges(bin_width):
     return np.linspace(PDF_RANGE[0], PDF_RANGE[1], count + 1)
 
 
-# ----------------------------------------------------------------------------
-# One surface
-# ----------------------------------------------------------------------------
+# --- One surface
 
 def flatten_moments(label, moments):
     """``{"x": {n: v}, "y": {n: v}}`` -> ``{"m<n><label>_x": v, "m<n><label>_y": v, "m<n><label>": mean}``."""
@@ -212,9 +208,7 @@ def default_psd_band(grid):
     return spectra.radial_bin_width(grid), min(grid.n0 / grid.l0, grid.n1 / grid.l1) / 2.0
 
 
-# ----------------------------------------------------------------------------
-# Ensemble over ranks
-# ----------------------------------------------------------------------------
+# --- Ensemble over ranks
 
 def surface_seeds(settings):
     """Seeds of the realisations in index order (:func:`roughpetsc.seeds.surface_seeds`); ``[None]`` for the
@@ -273,9 +267,7 @@ def ensemble_summary(ordered, edges):
     return {"per_surface": table, "mean": mean, "std": std, "counts": pooled, "edges": edges, "psd": psd}
 
 
-# ----------------------------------------------------------------------------
-# Closed forms and PDF comparison
-# ----------------------------------------------------------------------------
+# --- Closed forms and PDF comparison
 
 def closed_forms_from_options(options, settings):
     """Closed forms (2.21)-(2.25), (2.56)-(2.59) of the fractal PSD of the options; None for other surfaces."""
@@ -311,9 +303,7 @@ def pdf_distances(summary):
     return distances
 
 
-# ----------------------------------------------------------------------------
-# Entry point
-# ----------------------------------------------------------------------------
+# --- Entry point
 
 def compute(options, comm, settings, surface):
     """Compute the statistics on all ranks; the result document on rank 0, None elsewhere.

@@ -176,7 +176,6 @@ class Ensemble:
         self.saved = len(self.records)  # rank 0: surfaces in the file as last written
         self.write_error = None        # rank 0: why the file could not be written (then the run winds down)
         self.expected = len(self.todo)  # rank 0: records to wait for (fewer once the run winds down)
-        self.sends = []
         if self.rank == 0:
             provenance = io.provenance()
             grid = s.grid
@@ -278,10 +277,9 @@ class Ensemble:
                     time.sleep(IDLE_SLEEP)
         # Wait for the others without spinning (a blocking MPI call busy-waits and would take a core
         # from a group still at work when the machine is full).
-        requests = self.sends + [self.comm.Ibarrier()]
-        while not all(request.Test() for request in requests):
+        barrier = self.comm.Ibarrier()
+        while not barrier.Test():
             time.sleep(IDLE_SLEEP)
-        self.sends = []
 
     def finish(self):
         """Rank 0: the final file with statistics and models; returns the exit status on every rank."""

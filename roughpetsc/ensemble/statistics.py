@@ -129,9 +129,7 @@ def compute_models(pstar, alpha_h, alpha_p, surface, E_star, names, statistics):
     return out
 
 
-# ----------------------------------------------------------------------------
-# Reading them back (studies): as stored, completed for older or unfinished files
-# ----------------------------------------------------------------------------
+# --- Reading them back (studies): as stored, completed for older or unfinished files
 
 def stored_statistics(contents, say=print):
     """``{name: value}`` of ``/statistics`` of an ensemble file (a path or a :func:`roughpetsc.store.read` dict).

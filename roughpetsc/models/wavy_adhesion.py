@@ -12,47 +12,8 @@ Units: ``x``, ``a``, ``c``, ``lam``, ``h`` [length]; ``E_star``, ``sigma0``,
 ``pbar``, ``p`` [pressure]; ``w`` [energy/area]; stress intensity [pressure *
 length^(1/2)].
 
-Sources
--------
-[J95]  K. L. Johnson, Int. J. Solids Struct. 32 (1995) 423-430 (JKR wave).
-[W39]  H. M. Westergaard, J. Appl. Mech. 6 (1939) A49-A53 (non-adhesive wave);
-       Johnson, *Contact Mechanics* (1985), section 13.2.
-[K59]  W. T. Koiter, Ing.-Arch. 28 (1959) 168-172 (periodic collinear cracks).
-[CM04] G. Carbone, L. Mangialardi, J. Mech. Phys. Solids 52 (2004) 1267-1287,
-       Eq. (39): the mean gap of the JKR wave.
-[H01]  C.-Y. Hui, Y. Y. Lin, J. M. Baney, E. J. Kramer, J. Polym. Sci. B 39
-       (2001) 1195-1214; [JWG16] F. Jin, Q. Wan, X. Guo, J. Appl. Mech. 83
-       (2016) 101007: Maugis-Dugdale wave (papers not consulted here; the MD
-       solution below is derived independently, see :class:`WavyMaugisDugdale`).
-[BH97] J. M. Baney, C.-Y. Hui, J. Adhes. Sci. Technol. 11 (1997) 393-406
-       (MD cylinder: the small-contact limit of the MD wave).
-
-JKR wave [J95]
---------------
-With psi = pi a / lam, p* = pi E* h / lam (pressure of full contact) and
-Johnson's parameter alpha = sqrt(2 lam w / (pi^2 E* h^2)):
-
-    pbar / p* = sin^2 psi - alpha sqrt(tan psi).
-
-Derivation check (done here, agrees with [J95]): superpose Westergaard's
-non-adhesive solution of half-width a (pbar_W = p* sin^2 psi, bounded pressure)
-and Koiter's periodic "flat punch" of half-width a carrying the mean pressure
-pbar - pbar_W; its stress intensity at x = a is [K59]
-K = (pbar_W - pbar) sqrt(lam cot psi), and K^2 / (2 E*) = w gives the
-formula.  With w = 0 it is Westergaard's pbar = p* sin^2 psi [W39].
-
-Mean gap: the flat-punch compliance is -(2 lam/(pi E*)) ln sin psi, the
-Westergaard mean gap h (cos^2 psi + sin^2 psi ln sin^2 psi), in total [CM04]
-
-    gbar / h = cos^2 psi + (pbar / p*) ln sin^2 psi.
-
-Stationary points of pbar(a): alpha = 4 sin^(3/2) psi cos^(5/2) psi, with two
-roots (local minimum = load-control pull-off, local maximum = jump into full
-contact) for alpha < ALPHA_FOLD = 4 (3/8)^(3/4) (5/8)^(5/4) = 1.0652.  The
-maximum is <= 0, i.e. the surfaces jump into full contact spontaneously at
-zero load, for alpha >= ALPHA_SPONTANEOUS = max sin^(3/2) cos^(1/2) =
-3^(3/4)/4 = 0.5699 (psi = pi/3), the "alpha > 0.57" of [J95].  Once in full
-contact the JKR wave (no flaw) cannot be separated: pbar -> -inf as a -> lam/2.
+Sources ([J95], [W39], [K59], [CM04], [H01], [JWG16], [BH97]) and the derivation of the JKR wave and its
+stationary points: docs/models.md.
 """
 
 import numpy as np
@@ -144,7 +105,7 @@ def jkr_mean_pressure(a, lam, h, E_star, w):
 def jkr_stress_intensity(a, pbar, lam, h, E_star):
     """Mode-I stress intensity at the contact edge for half-width a and mean
     pressure pbar: K = (p* sin^2 psi - pbar) sqrt(lam cot psi) [pressure*length^0.5]
-    (Westergaard + Koiter superposition, see module doc; [CM04] symmetric case)."""
+    (Westergaard + Koiter superposition, docs/models.md; [CM04] symmetric case)."""
     psi = _psi(a, lam)
     return ((full_contact_pressure(lam, h, E_star) * np.sin(psi) ** 2 - pbar)
             * np.sqrt(lam / np.tan(psi)))
@@ -180,6 +141,12 @@ def jkr_stationary_points(alpha):
             brentq(g, top, np.pi / 2, xtol=1e-15, rtol=1e-15))
 
 
+def _jkr_stationary_state(which, lam, h, E_star, w):
+    """(pbar, a) at the stationary point ``which`` (0: local minimum, 1: local maximum) of pbar(a)."""
+    a = jkr_stationary_points(johnson_alpha(lam, h, E_star, w))[which] * lam / np.pi
+    return float(jkr_mean_pressure(a, lam, h, E_star, w)) if np.isfinite(a) else np.nan, a
+
+
 def jkr_pulloff_load_control(lam, h, E_star, w):
     """Load-control pull-off from a partial-contact state: the local minimum of
     pbar(a) [J95].
@@ -193,18 +160,14 @@ def jkr_pulloff_load_control(lam, h, E_star, w):
         For alpha >= ALPHA_SPONTANEOUS the surfaces are in full contact at
         zero load and the ideal JKR wave has no finite pull-off from there.
     """
-    psi = jkr_stationary_points(johnson_alpha(lam, h, E_star, w))[0]
-    a = psi * lam / np.pi
-    return float(jkr_mean_pressure(a, lam, h, E_star, w)) if np.isfinite(a) else np.nan, a
+    return _jkr_stationary_state(0, lam, h, E_star, w)
 
 
 def jkr_jump_in(lam, h, E_star, w):
     """Local maximum of pbar(a): above it (load control) the surfaces jump into
     full contact [J95].  Returns (pbar [pressure], a [length]); pbar <= 0 iff
     alpha >= ALPHA_SPONTANEOUS."""
-    psi = jkr_stationary_points(johnson_alpha(lam, h, E_star, w))[1]
-    a = psi * lam / np.pi
-    return float(jkr_mean_pressure(a, lam, h, E_star, w)) if np.isfinite(a) else np.nan, a
+    return _jkr_stationary_state(1, lam, h, E_star, w)
 
 
 def jkr_pulloff_displacement_control(lam, h, E_star, w):
@@ -252,52 +215,9 @@ class WavyMaugisDugdale:
     r"""Maugis-Dugdale adhesion of the wave: Dugdale stress sigma0 acting where the
     gap is below h0 = w/sigma0.
 
-    Derivation (independent; the papers [H01], [JWG16] treat the same problem
-    but were not consulted).  For a load symmetric about x = 0 the periodic
-    kernel ln|2 sin(pi (x - x')/lam)| symmetrised is ln 2 + ln|s - s'| in
-    s = sin(pi x/lam): the wave becomes a plane (non-periodic) contact problem
-    in s with the parabolic profile 2 h s^2 (Westergaard's wave -> Hertz's
-    cylinder) and the load density P(s) = p(x) dx/ds.  The Dugdale stress
-    sigma0 on a < |x| < c is then sigma0 lam/(pi sqrt(1 - s^2)) on b < |s| < s_c,
-    b = sin(pi a/lam), s_c = sin(pi c/lam).  With the analytic-function solution
-    of the mixed problem (contact |s| < b), bounded pressure at the contact edge
-    gives, in the parameter beta in [0, pi/2] defined by
-    sin^2 beta = (s_c^2 - b^2)/(1 - b^2),
-
-        pbar = p* sin^2(pi a/lam) - (2 sigma0/pi) beta,                    (MD1)
-
-    the gap at the end of the Dugdale zone (= h0, condition (MD2)) is
-
-        g(c) = 2 h [s_c sqrt(s_c^2 - b^2) - b^2 arccosh(s_c/b)]
-               + (2 sigma0 lam/(pi^2 E*)) J,
-        J = int_{pi a/lam}^{pi c/lam} ln[(cos theta tan beta + sqrt(sin^2 theta - b^2))
-                / |cos theta tan beta - sqrt(sin^2 theta - b^2)|] d theta,
-
-    the contact pressure (|x| < a) is Westergaard's minus
-    (2 sigma0/pi) arctan[tan beta sqrt((1 - s^2)/(b^2 - s^2))], and the mean gap
-    (by reciprocity with the unit flat punch) is
-
-        gbar = h [1 - b^2 + b^2 ln b^2] + (4 sigma0 lam/(pi^2 E*))
-               [ln b (pi c/lam - pi a/lam - beta)
-                - int_{pi a/lam}^{pi c/lam} ln(sin theta + sqrt(sin^2 theta - b^2)) d theta].
-
-    Checks: the same construction with a uniform Dugdale stress reproduces
-    Baney & Hui's MD cylinder [BH97] (load and Eq. (23), verified while deriving),
-    and the tests show this wave tends to it for a, c << lam (deviation ~ lam^-2);
-    sigma0 -> inf gives Johnson's JKR wave (~ sigma0^-2); the pressure field,
-    its mean, the conformity in the contact, the gap h0 at c and gbar are
-    confirmed by direct quadrature with the periodic kernel (no s-mapping).
-
-    States.  beta = pi/2 (c = lam/2) is the saturated state: the Dugdale stress
-    acts over the whole gap, pbar = p* sin^2 psi - sigma0, no extra deformation
-    (uniform tension), gbar = Westergaard's; it is admissible while the largest
-    (Westergaard) gap 2h [sqrt(1-b^2) - b^2 arccosh(1/b)] <= h0, i.e.
-    a >= ``a_saturation``.  Unsaturated states: for fixed beta the gap g(c)
-    decreases with a (checked numerically), so each beta with g(c)|_{a=0} >= h0
-    has one contact half-width a(beta); the beta-branch joins the saturated one
-    at a_saturation as beta -> pi/2.  At fixed a there may be several states.
-    The non-contact states (a = 0) are not modelled, except the saturated
-    non-contact state pbar = -sigma0 that exists when h0 >= 2h.
+    A state is (a, beta), sin^2 beta = (s_c^2 - b^2)/(1 - b^2) with b = sin(pi a/lam), s_c = sin(pi c/lam):
+    (MD1) pbar = p* sin^2(pi a/lam) - (2 sigma0/pi) beta, (MD2) the gap at x = c is h0; beta = pi/2 is the
+    saturated state (c = lam/2). Derivation, checks and the solution set: docs/models.md.
 
     Parameters
     ----------

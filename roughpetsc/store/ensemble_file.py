@@ -205,9 +205,7 @@ def records_of(contents):
     return records
 
 
-# ----------------------------------------------------------------------------
-# Comparison
-# ----------------------------------------------------------------------------
+# --- Comparison
 
 _RESIDUALS = ("steps/kkt_natural", "steps/kkt_complementarity", "steps/kkt_min_p", "steps/kkt_min_g",
               "steps/kkt_load_error")

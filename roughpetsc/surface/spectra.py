@@ -37,9 +37,7 @@ SEED_STENCILS = "seed"
 FD_SCHEMES = ("seed", "central")
 
 
-# ----------------------------------------------------------------------------
-# Moments of a discrete field
-# ----------------------------------------------------------------------------
+# --- Moments of a discrete field
 
 def rfft_multiplicity(n1):
     """How often each column of an ``rfft2`` spectrum appears in the full spectrum.
@@ -266,9 +264,7 @@ def isotropic_mean(moments):
     return {n: 0.5 * (moments["x"][n] + moments["y"][n]) for n in moments["x"]}
 
 
-# ----------------------------------------------------------------------------
-# Bandwidth parameters
-# ----------------------------------------------------------------------------
+# --- Bandwidth parameters
 
 def bandwidth(m0, m2, m4):
     """Nayak's bandwidth parameter alpha = m0 m4 / m2^2, eq. (2.16) (also (2.54) with p-moments). Dimensionless."""
@@ -280,9 +276,7 @@ def pressure_bandwidth_from_heights(m2h, m4h, m6h):
     return 27.0 / 20.0 * m2h * m6h / m4h ** 2
 
 
-# ----------------------------------------------------------------------------
-# Closed forms for the self-affine PSD (2.18)
-# ----------------------------------------------------------------------------
+# --- Closed forms for the self-affine PSD (2.18)
 
 def isotropy_factor(n):
     """``1*3*...*(n-1) / (2*4*...*n)`` of (2.15); 1 for n = 0."""
@@ -367,9 +361,7 @@ def fractal_closed_forms(k_l, k_s, hurst, amplitude, e_star=1.0):
     }
 
 
-# ----------------------------------------------------------------------------
-# Pressure surface
-# ----------------------------------------------------------------------------
+# --- Pressure surface
 
 def pressure_surface(grid, heights, e_star=1.0):
     """Complete-contact pressure p_c = F^-1[pi E* k F[h]], eq. (2.47).
@@ -423,9 +415,7 @@ def heights_from_pressure_surface(grid, complete_contact_pressure, e_star=1.0):
     return np.fft.irfft2(spectrum, s=grid.shape)
 
 
-# ----------------------------------------------------------------------------
-# Everything for one surface
-# ----------------------------------------------------------------------------
+# --- Everything for one surface
 
 def surface_moment_summary(grid, heights, e_star=1.0, scheme=SEED_STENCILS):
     """Moments and bandwidths of a surface and of its pressure surface.

@@ -110,9 +110,7 @@ def find_summits(grid, field):
                    hessian_determinant=f_xx * f_yy - f_xy ** 2, area=grid.area)
 
 
-# ----------------------------------------------------------------------------
-# Closed-form densities of an isotropic Gaussian surface
-# ----------------------------------------------------------------------------
+# --- Closed-form densities of an isotropic Gaussian surface
 
 def summit_height_pdf(xi, alpha):
     """PDF of the dimensionless summit height xi* = xi / sqrt(m0), eq. (2.42) (Nayak; Greenwood, App. A).
@@ -225,9 +223,7 @@ def measured_gw_inputs(summits):
     }
 
 
-# ----------------------------------------------------------------------------
-# Measured densities and their distance to a closed form
-# ----------------------------------------------------------------------------
+# --- Measured densities and their distance to a closed form
 
 def binned_counts(values, edges):
     """Counts of ``values`` in the bins of ``edges`` and the total number of finite values.
