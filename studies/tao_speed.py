@@ -239,8 +239,8 @@ def report(rows, profile, folder):
              "`before` was measured at N = 512, p* = 0.5 only (each root-find solve costs minutes at 1024); GPCG "
              "under load control stalls after 1-2 inner solves at p* >= 0.5 (its projected search, as in the "
              "residual floors of tao_floors.py) and was not rerun at N = 1024 (`--solvers blmvm bqnls tron`). "
-             "The PK, BLMVM and BQNLS `after` rows are of the penalty 0.1 and unrecycled memory of the "
-             "quasi-Newton types (`--solvers blmvm bqnls`); the TRON and GPCG `after` rows were not rerun "
+             "The PK, BLMVM and BQNLS `after` rows are of the penalty 0.1, unrecycled memory and inner "
+             "tolerance 0.3 (`--solvers blmvm bqnls`); the TRON and GPCG `after` rows were not rerun "
              "(commit 4ed21eb, contact stiffness to 0.1 % then: TRON took 452, 557, 562 pairs at N = 512 with "
              "1 %), so their `x PK` columns divide by the later PK run.", ""] + TRIED
     if rows:
