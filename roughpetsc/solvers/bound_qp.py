@@ -10,20 +10,24 @@ separation d. Each inner solve minimises, by the TAO type,
     L(p; lambda) = 1/2 p'Kp - p'h + lambda (sum p - n pbar) + c n / 2 (mean p - pbar)^2,  p >= 0,
 
 whose gradient is the gap ``K p - h + d`` at ``d = lambda + c (mean p - pbar)``: the solution is the
-displacement-controlled one at that d, with the rigid flat held by a spring of compliance c. The quadratic part
-is the same for every lambda, so the quasi-Newton memory stays valid from one inner solve to the next
-(``-bound_al_recycle``) and so does the pressure (warm start). lambda starts at the previous load's separation
-along a load path, else at Polonsky-Keer's separation of the start (zero mean gap on its contact set). Between
-inner solves lambda moves to the root of P(d) = pbar, P the mean pressure of the displacement-controlled
+displacement-controlled one at that d, with the rigid flat held by a spring of compliance c. The quadratic part is
+the same for every lambda, so the pressure stays a warm start from one inner solve to the next. The quasi-Newton
+memory does not (``-bound_al_recycle``, off): its first pair after a new lambda takes the constant shift of the
+gradient for curvature, and keeping it cost 2 to 20 % more pairs (N = 512). lambda starts at the previous load's
+separation along a load path, else at Polonsky-Keer's separation of the start (zero mean gap on its contact set).
+Between inner solves lambda moves to the root of P(d) = pbar, P the mean pressure of the displacement-controlled
 solution: first by a Newton step with the contact stiffness k = -dP/dd = 1_C' K_CC^-1 1_C / n of the first inner
-solution (:func:`contact_stiffness`, a preconditioned CG on its contact set, 10 to 20 operator applications;
-``-bound_al_newton false``: the method of multipliers, lambda <- d), then by secants on (d, log P), kept inside
-the bracket the pairs give. The inner solves are inexact: one stops once its natural residual is below
-``-bound_al_eta`` times its load error (the stopping rule's ``inner_eta``); only the last is solved to the
-tolerance. The penalty c is in units of the compliance of the longest wavelength, L / pi
-(``-bound_al_penalty``, 1): the Hessian ``K + c/n 1 1'`` then has the spectrum of K with the rigid mode at the
-top of it (c = 10 or 100 cost 3 to 19 times more). ``-bound_load rootfind`` keeps the former method, a
-safeguarded root find on d around displacement-controlled solves (:mod:`~roughpetsc.solvers.root_find`).
+solution (:func:`contact_stiffness`, a preconditioned CG on its contact set to 1 % in k, 7 to 11 operator
+applications; ``-bound_al_newton false``: the method of multipliers, lambda <- d), then by secants on (d, log P),
+kept inside the bracket the pairs give. The inner solves are inexact: one stops once its natural residual is below
+``-bound_al_eta`` (0.3) times its load error (the stopping rule's ``inner_eta``); only the last is solved to the
+tolerance (0.3 against 0.1: 3-19 % fewer pairs for BLMVM and BQNLS in 11 of 12 loads at N = 512 and 1024, 9 % more
+in one). The penalty c is in units of the compliance of the longest wavelength, L / pi (``-bound_al_penalty``):
+0.1 for the quasi-Newton types with the Fourier H0 (their first inner solve, at a poor lambda, is then cheap and
+the Newton step mends the load), 1 for the others. Penalties of 10 and more stall BLMVM and BQNLS near the start
+(natural residual about 3 after 1000 pairs, failed line searches), likely as the projection of each trial onto
+p >= 0 moves mean(p), which the penalty charges. ``-bound_load rootfind`` keeps the former method, a safeguarded
+root find on d around displacement-controlled solves (:mod:`~roughpetsc.solvers.root_find`).
 
 **The Fourier initial Hessian for the quasi-Newton types** (``-bound_h0 fourier|none``): BLMVM, BQNLS and the
 other BQNK types start each L-BFGS two-loop recursion from ``gamma B r``, B Polonsky-Keer's preconditioner on
@@ -75,6 +79,11 @@ INITIAL_HESSIANS = ("fourier", "none")
 LOAD_METHODS = ("al", "rootfind")
 # Bounds of the initial Hessian's scale gamma; it settled at 0.1-0.3 in the solves measured.
 GAMMA_BOUNDS = (1e-3, 1e3)
+# The default penalty c of the augmented Lagrangian (units of L / pi): with the Fourier H0, BLMVM and BQNLS took
+# 6-39 % fewer FFT pairs at 0.1 than at 1 in 10 of 12 load-controlled solves (group #1, N = 512 and 1024,
+# p* = 0.05, 0.5, 2), 4-39 % more in two at p* = 2; 0.03 and 0.3 did worse than 0.1. TRON and BNLS did not gain
+# (TRON 452 -> 523 pairs at p* = 0.05) and keep 1.
+PENALTY_QUASI_NEWTON, PENALTY_OTHERS = 0.1, 1.0
 # Restarts of a TAO solve that stopped for round-off: at most this many, and only while each attempt lowers the
 # best natural residual below this fraction of the previous one.
 MAX_RESTARTS = 8
@@ -88,11 +97,12 @@ OPTIONS = [
     ("bound_load", "al", "TAO bound types under load control: al (augmented Lagrangian on mean(p) = pbar inside "
                          "the solve) | rootfind (a safeguarded root find on the separation around displacement "
                          "control)"),
-    ("bound_al_penalty", 1.0, "augmented Lagrangian: penalty c in units of the compliance of the longest wavelength"),
-    ("bound_al_eta", 0.1, "augmented Lagrangian: an inner solve stops once its natural residual is below this "
+    ("bound_al_penalty", "", "augmented Lagrangian: penalty c in units of the compliance of the longest wavelength "
+                             "(default 0.1 for the quasi-Newton types with the Fourier H0, 1 for the others)"),
+    ("bound_al_eta", 0.3, "augmented Lagrangian: an inner solve stops once its natural residual is below this "
                           "times its load error, in [0, 1)"),
     ("bound_al_max_outer", 40, "augmented Lagrangian: at most this many inner solves"),
-    ("bound_al_recycle", True, "augmented Lagrangian: keep the quasi-Newton memory from one inner solve to the next"),
+    ("bound_al_recycle", False, "augmented Lagrangian: keep the quasi-Newton memory from one inner solve to the next"),
     ("bound_al_newton", True, "augmented Lagrangian: first multiplier step by the contact stiffness (else lambda <- d)"),
 ]
 
@@ -316,7 +326,7 @@ def _set_recycle(tao, flag):
     _check(library.TaoLMVMRecycle(handle, ctypes.c_int(bool(flag))), "TaoLMVMRecycle")
 
 
-def contact_stiffness(problem, pressure, preconditioner, rtol=1e-3, max_it=30):
+def contact_stiffness(problem, pressure, preconditioner, rtol=1e-2, max_it=30):
     """The contact stiffness k = -dP/dd = 1_C' K_CC^-1 1_C / n of the solution ``pressure``, by PCG on its contact set C.
 
     The mean pressure of the displacement-controlled solution changes at this rate with the separation while
@@ -406,12 +416,14 @@ class BoundQP(Backend):
         self.max_seconds = settings.rule.max_seconds
         self.prefix = settings.prefix
         options = PETSc.Options(settings.prefix)
-        self.penalty_factor = options.getReal("bound_al_penalty", 1.0)
-        self.eta = options.getReal("bound_al_eta", 0.1)
-        self.max_outer = options.getInt("bound_al_max_outer", 40)
-        self.recycle = options.getBool("bound_al_recycle", True)
-        self.newton = options.getBool("bound_al_newton", True)
         h0 = options.getString("bound_h0", "") or ("fourier" if tao_type in QUASI_NEWTON_TYPES else "none")
+        quasi_newton_h0 = h0 == "fourier" and tao_type in QUASI_NEWTON_TYPES
+        self.penalty_factor = options.getReal("bound_al_penalty",
+                                              PENALTY_QUASI_NEWTON if quasi_newton_h0 else PENALTY_OTHERS)
+        self.eta = options.getReal("bound_al_eta", 0.3)
+        self.max_outer = options.getInt("bound_al_max_outer", 40)
+        self.recycle = options.getBool("bound_al_recycle", False)
+        self.newton = options.getBool("bound_al_newton", True)
         preconditioner = options.getString("bound_pc", "") or \
             ("fourier" if tao_type in FOURIER_DEFAULT_TYPES else "none")
         self._check_options(h0, preconditioner)
@@ -445,7 +457,7 @@ class BoundQP(Backend):
         tao.setMaximumFunctionEvaluations(10 * DEFAULT_MAX_IT)
         with default_options(self._default_options(tao_type, h0), settings.prefix):
             set_from_options(tao, self.destroy)
-        if h0 == "fourier" and tao_type in QUASI_NEWTON_TYPES:
+        if quasi_newton_h0:
             self.initial_context = FourierInitialHessian(problem, self.objective)
             self.initial_hessian = problem.operator.mat(self.initial_context)
             _set_lmvm_initial_hessian(tao, tao_type, self.initial_hessian)
