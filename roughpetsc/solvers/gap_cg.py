@@ -12,7 +12,9 @@ as the unknown and the mean gap as the constraint, with three changes of ours:
 * the step minimises the quadratic model with the law's curvature phi'' when that model is convex and
   the elastic one otherwise, and is then cut back until the energy decreases (Armijo), since phi makes
   the energy non-convex: the iterates follow the energy downhill to the local minimum next to the
-  start, which is what a quasi-static path of adhesive contact needs.
+  start, which is what a quasi-static path of adhesive contact needs. A step that needs the projection
+  is kept only if the projected gap's energy is lower, and a solve whose energy still falls is not
+  stagnating (a descent past a jump out of contact can take hundreds of iterations at a large residual).
 
 After each step the gap is projected onto {g >= 0, mean g = gbar} exactly (a shift of the positive
 nodes found by Newton's method on a piecewise-linear function). Every stop is decided on a freshly
@@ -33,6 +35,9 @@ from .stopping import ConvergenceTest, History, Verdict, check_convergence, desc
 REFRESH = 50  # recompute S g at least every REFRESH iterations (the update S g -= step S t drifts)
 ARMIJO = 1e-4
 MAX_BACKTRACKS = 40
+# A fall of the energy by this fraction of the work of adhesion (over the surface) since the last counts as progress (it restarts
+# the stagnation count): far above the round-off floor, where steps change the energy by residual^2.
+ENERGY_PROGRESS = 1e-10
 
 
 def project_mean(mpi, g, target, n):
@@ -64,6 +69,8 @@ class _Scratch:
         self.open = np.empty(size, dtype=bool)
         # the line search's parts of phi (interaction laws' energy_changes_from)
         self.law = (np.empty(size), np.empty(size), np.empty(size))
+        self.before = np.empty(size)  # the gap before a step, and S (g + h) there: a projected step may be undone
+        self.elastic = np.empty(size)
         self.best = np.empty(size)  # an iterate near the lowest natural residual, returned by a stop short of it
 
 
@@ -129,7 +136,7 @@ class GapCG:
         tao.setIterationNumber(0)
         self.failure = None
         rz_old, fresh_needed, since_fresh = 1.0, True, 0
-        saved = np.inf
+        saved, fallen = np.inf, 0.0
         iteration, reason = 0, PETSc.TAO.Reason.DIVERGED_MAXITS
         while True:
             if fresh_needed or since_fresh >= REFRESH:
@@ -175,24 +182,56 @@ class GapCG:
             curvature = curvature_elastic + _law_curvature(law, mpi, g, t, work)
             if not curvature > 0:
                 curvature = curvature_elastic
-            step = _armijo_step(problem, g, t, slope, curvature_elastic, elastic_slope, slope / curvature, work,
-                                scratch.law)
-            if step is None:
+            change, projected = self._descend(gap_vec, t, slope, (curvature_elastic, elastic_slope),
+                                              slope / curvature, scratch)
+            if change is None:
                 reason, self.failure = PETSc.TAO.Reason.DIVERGED_LS_FAILURE, \
                     "no decrease of the energy along the direction"
                 break
-            if allsum(mpi, [loops.gap_step(g, t, step)])[0]:
-                project_mean(mpi, g, target, n)
-                fresh_needed = True
-            else:
-                loops.subtract_scaled(elastic, response, step)
-            since_fresh += 1
+            since_fresh = 0 if projected else since_fresh + 1
+            fallen -= change
+            if fallen > ENERGY_PROGRESS * law.work * n:
+                # The energy still falls: a long descent (past a jump in or out of contact), not stagnation.
+                self.watch.restart(iteration)
+                fallen = 0.0
             iteration += 1
             tao.setIterationNumber(iteration)
         if reason < 0 and np.isfinite(self.watch.best_natural) and natural > saved:
             np.copyto(g, scratch.best)  # an iterate within a factor 2 of the best; the facade certifies it
         tao.setIterationNumber(iteration)
         tao.setConvergedReason(reason)
+
+    def _descend(self, gap_vec, t, slope, elastic_parts, step, scratch):
+        """Step the gap of ``gap_vec`` along -t by the first of ``step``, step/2, ... that lowers the energy enough;
+        ``(change of the energy, whether S g was computed afresh)``, or (None, False) if no step does.
+
+        Armijo's test is on the line before the projection (:func:`_armijo_step`). A step that crosses g = 0 is
+        projected and kept only if the energy of the projected gap, on a fresh S g, is below that before
+        the step: the line continues phi below 0 by its tangent, so a long step there can look downhill and
+        project to a gap of higher energy in another basin (a retraction past snap-off that jumped back
+        into a wider contact, and stagnated there).
+        """
+        problem = self.problem
+        elastic_vec = self.vecs[4]
+        g, elastic, response = (problem.local(v).ravel() for v in (gap_vec, elastic_vec, self.vecs[1]))
+        while True:
+            step, change = _armijo_step(problem, g, t, slope, *elastic_parts, step, scratch.work, scratch.law)
+            if step is None:
+                return None, False
+            np.copyto(scratch.before, g)
+            if not allsum(problem.mpi, [loops.gap_step(g, t, step)])[0]:
+                loops.subtract_scaled(elastic, response, step)
+                return change, False
+            before = problem.energy(scratch.before, elastic)
+            np.copyto(scratch.elastic, elastic)
+            project_mean(problem.mpi, g, self.target, problem.n)
+            problem.elastic_pressure(gap_vec, elastic_vec)
+            change = (problem.energy(g, elastic) - before) * problem.n  # a sum over the nodes, as Armijo's
+            if change < 0:
+                return change, True
+            np.copyto(g, scratch.before)
+            np.copyto(elastic, scratch.elastic)
+            step *= 0.5
 
 
 class GapCGBackend(Backend):
@@ -248,7 +287,8 @@ def _feasible(mpi, t, r, open_nodes, open_count):
 
 
 def _armijo_step(problem, g, t, slope, curvature_elastic, elastic_slope, step, trial, law_scratch):
-    """The first of ``step``, step/2, ... along -t that decreases the energy enough (None if none does).
+    """The first of ``step``, step/2, ... along -t that decreases the energy enough, and that decrease (None, None if
+    none does).
 
     The test is on the energy along the line before the projection (phi continued below g = 0 by its
     tangent, :meth:`energy_change` of the laws), whose slope at 0 is exactly ``slope``; the projection
@@ -264,9 +304,9 @@ def _armijo_step(problem, g, t, slope, curvature_elastic, elastic_slope, step, t
         law_change, = allsum(mpi, [changes(trial, trial).sum()])
         change = step * (0.5 * step * curvature_elastic - elastic_slope) + law_change
         if change <= -ARMIJO * step * slope:
-            return step
+            return step, change
         step *= 0.5
-    return None
+    return None, None
 
 
 register("gapcg", GapCGBackend, controls=("displacement",), kinds=("adhesive",))

@@ -296,6 +296,31 @@ def test_dugdale_wave_meets_maugis_dugdale_wave():
     assert pull_off == pytest.approx(model.pulloff()[0], rel=0.025)
 
 
+def test_retraction_descends_to_the_maugis_dugdale_snap_off():
+    """Johnson's wave (alpha = 0.5, h0 = 0.1 h: Maugis's lambda 3.8) jumps into contact at gbar = h and is
+    retracted past its snap-off. Every solve ends below the energy of its start, the previous gap shifted by
+    the step (a step of the gap CG across g = 0 once projected into a wider contact of higher energy), and
+    the contact snaps off at the largest mean gap of the Maugis-Dugdale solution set, 1.677 h, within the
+    grid's error (measured: 1.690 h at N = 2048) and the path's step.
+    """
+    from roughpetsc.models.wavy_adhesion import WavyMaugisDugdale
+    from roughpetsc.surface.generators import wave
+
+    amplitude, step, n = 1e-3, 3e-5, 2048
+    work = 0.5 ** 2 * math.pi ** 2 * amplitude ** 2 / 2
+    stress = work / (0.1 * amplitude)
+    grid = Grid(4, n, 4.0 / n, 1.0)
+    with adhesive_problem(grid, wave(grid, amplitude, 1.0), 1.0, Dugdale(work, stress), 1e-10) as adhesive:
+        result = adhesive.solve(gbar=amplitude)
+        while result.A > 0:
+            start = adhesive.problem.energy_of(adhesive.fields()[1] + step)
+            result = adhesive.solve(gbar=result.gbar + step)
+            assert result.converged, result.reason
+            assert adhesive.problem.energy_of(adhesive.fields()[1]) <= start
+    curve = WavyMaugisDugdale(1.0, amplitude, 1.0, work, stress).curve(2000)
+    assert result.gbar - step == pytest.approx(np.nanmax(curve["gbar"]), abs=0.02 * amplitude + step)
+
+
 @pytest.mark.parametrize("tabor, radius_0, median_tolerance, pulloff_tolerance",
                          [(0.5, 0.1, 0.05, 0.015), (0.1, 0.05, 0.08, 0.03)])
 def test_dugdale_sphere_meets_maugis(tabor, radius_0, median_tolerance, pulloff_tolerance):
