@@ -1,23 +1,11 @@
 """The ``stats`` mode: moments, bandwidths, pressure surface and summit PDFs of a surface or an ensemble.
 
-Usage (the lead wires ``python -m roughpetsc -mode stats`` to :func:`run`)::
+Usage::
 
     mpiexec -n 2 python -m roughpetsc -mode stats -options_file options/group01.opts \\
         -stats_ensemble 20 -stats_json g1.json -stats_h5 g1.h5 -stats_plot g1
 
-Ensembles: realisation ``i = 0 .. n-1`` is the fractal surface of the options
-with the white-noise seed :func:`roughpetsc.seeds.surface_seed` ``(-ensemble_seed, i)``, the
-rule of ``-mode ensemble``: the same master seed gives the same surfaces in both
-modes, on any number of ranks. Whole surfaces are dealt to the ranks
-(surface ``i`` on rank ``i % size``); the per-surface values are gathered on
-rank 0, which forms means and standard deviations (sample std, ddof = 1) in
-seed order and sums the integer histogram counts, so any number of ranks
-gives bit-identical results. With ``-stats_ensemble 0`` the one surface named
-by the options (any type, or ``-surface_file``) is characterised.
-
-Every summary quantity is also written per surface (JSON ``per_surface``, HDF5
-dataset ``per_surface/<name>`` in seed order). What the mode prints and writes (the result
-document, the report table, the PDF plots) is :mod:`roughpetsc.stats_output`.
+An ensemble over ranks, and what is written per surface: docs/runtime.md, "Ensembles over ranks".
 """
 
 from dataclasses import asdict, dataclass

@@ -1,13 +1,6 @@
 """The run of ``-mode ensemble``: groups of ranks solve whole surfaces; world rank 0 keeps the file.
 
-* COMM_WORLD is split into groups of ``-ensemble_group_ranks`` ranks; each group solves whole surfaces
-  on its own communicator, the next one drawn from the work counter (:mod:`.scheduler`).
-* Surface ``i`` is the fractal surface of the ``-surface_*`` options with the white-noise seed of
-  :func:`roughpetsc.seeds.surface_seed` ``(ensemble_seed, i)``, solved along the loads in order, each
-  step warm-started from the previous one (load control, the solver of the PETSc options).
-* Leaders send each finished surface to rank 0, which looks for them between its own load steps and
-  rewrites the whole file after every finished surface (:mod:`roughpetsc.store.ensemble_file`,
-  atomically). Resume keeps the finished surfaces of an existing file of the same configuration.
+How groups, surfaces and the file fit together: docs/runtime.md, "Ensembles over ranks".
 """
 
 import json
