@@ -11,6 +11,7 @@ import traceback
 
 import numpy as np
 
+from ..app.terminal import printer
 from ..store import outputs as io
 from ..errors import UserError
 from ..surface.seeds import RULE as SEED_RULE, surface_seed
@@ -138,7 +139,7 @@ class Ensemble:
         self.reader, self.s, self.config = reader, s, config
         self.comm = comm.Dup()               # our own messages never meet PETSc's or mpi4py-fft's
         self.rank, self.size = self.comm.Get_rank(), self.comm.Get_size()
-        self.quiet = s.quiet
+        self.say = printer(s.quiet, comm)  # print on rank 0 unless -quiet
         self.records, self.runs, self.wisdom, error = [], [], "", None
         if self.rank == 0:
             try:
@@ -189,10 +190,6 @@ class Ensemble:
         io.on_root(self.comm, self.write)  # a file rank 0 cannot write stops every rank, not rank 0 alone
 
     # --- rank 0: file and progress -------------------------------------------
-    def say(self, text):
-        if not self.quiet and self.rank == 0:
-            print(text, flush=True)
-
     def write(self, models=None):
         attrs = dict(self.attrs, complete=len(self.records) == self.s.size, runs=json.dumps(self.runs))
         records = sorted(self.records, key=lambda r: r["surface"]["index"])
