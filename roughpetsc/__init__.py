@@ -33,38 +33,24 @@ from .lazy import exports  # noqa: E402  (after the thread limits: it imports no
 
 __version__ = "0.1.0"
 
-# Public name -> (module, name in that module).
+# Module -> the public names it defines (renamed ones below).
 _EXPORTS = {
     # surfaces (section 7.1 of the dissertation) and their readers
-    "Grid": ("surface.grid", "Grid"),
-    "square_grid": ("surface.grid", "square_grid"),
-    "fractal": ("surface.generators", "fractal"),
-    "fractal_amplitude": ("surface.generators", "fractal_amplitude"),
-    "fractal_psd": ("surface.generators", "fractal_psd"),
-    "wave": ("surface.generators", "wave"),
-    "bisinusoid": ("surface.generators", "bisinusoid"),
-    "hertz_sphere": ("surface.generators", "hertz_sphere"),
-    "load_surface": ("surface.files", "load"),
-    "fractal_group": ("app.presets", "fractal_group"),
-    "read_opts": ("app.presets", "read_opts"),
+    "surface.grid": "Grid square_grid",
+    "surface.generators": "fractal fractal_amplitude fractal_psd wave bisinusoid hertz_sphere",
+    "app.presets": "fractal_group read_opts",
     # statistics (chapter 2, section 7.2)
-    "spectral_moments": ("surface.spectra", "spectral_moments"),
-    "fd_moments": ("surface.spectra", "fd_moments"),
-    "isotropic_mean": ("surface.spectra", "isotropic_mean"),
-    "bandwidth": ("surface.spectra", "bandwidth"),
-    "pressure_surface": ("surface.spectra", "pressure_surface"),
-    "heights_from_pressure_surface": ("surface.spectra", "heights_from_pressure_surface"),
-    "fractal_closed_forms": ("surface.spectra", "fractal_closed_forms"),
-    "surface_moments": ("surface.moments", "surface_moments"),
+    "surface.spectra": "spectral_moments fd_moments isotropic_mean bandwidth pressure_surface "
+                       "heights_from_pressure_surface fractal_closed_forms",
+    "surface.moments": "surface_moments",
     # the contact problem (3.41)-(3.44), its solvers and their results
-    "ContactProblem": ("contact.problem", "ContactProblem"),
-    "Result": ("contact.result", "Result"),
-    "Westergaard": ("elastic.westergaard", "Westergaard"),
-    "load_history": ("contact.loads", "history"),
-    "Solver": ("solvers", "Solver"),
-    "load_path": ("solvers", "load_path"),
+    "contact.problem": "ContactProblem",
+    "contact.result": "Result",
+    "elastic.westergaard": "Westergaard",
+    "solvers": "Solver load_path",
     # errors
-    "ParameterError": ("errors", "ParameterError"),
+    "errors": "ParameterError",
 }
 
-__getattr__, __dir__, __all__ = exports(__name__, _EXPORTS, submodules=("models",))
+__getattr__, __dir__, __all__ = exports(__name__, _EXPORTS, submodules=("models",), renamed={
+    "load_surface": ("surface.files", "load"), "load_history": ("contact.loads", "history")})

@@ -7,11 +7,15 @@ The command line hands PETSc its options (``petsc4py.init(argv)``) before anythi
 import importlib
 
 
-def exports(package, table, submodules=()):
-    """``(__getattr__, __dir__, __all__)`` of ``package`` for ``table`` = ``{public name: (module, name)}``.
+def exports(package, modules, submodules=(), renamed=None):
+    """``(__getattr__, __dir__, __all__)`` of ``package`` for ``modules`` = ``{module: "name name ..."}``.
 
-    ``module`` is relative to ``package``; ``submodules`` are subpackages returned as modules.
+    ``module`` is relative to ``package``, each name exported as that module calls it; ``renamed`` =
+    ``{public name: (module, name)}`` exports a name under another; ``submodules`` are subpackages returned as
+    modules.
     """
+    table = {name: (module, name) for module, names in modules.items() for name in names.split()}
+    table.update(renamed or {})
     namespace = importlib.import_module(package).__dict__
 
     def __getattr__(name):

@@ -4,10 +4,9 @@
     mpiexec -n 2 python -m roughpetsc -tao_type bqnls     # load control: BQNLS in an augmented Lagrangian
     python -m roughpetsc -pstar_list 0.1,0.5,1 -json out.json -output out.h5
 
-Exit status: 0 success, 2 bad input (one message, no traceback, no output
-file), 3 a solve did not converge (reported as such; files are written and
-flag it), 130 interrupted by Ctrl-C or SIGTERM (the finished steps are written;
--resume continues).
+Exit status: 0 success, 2 bad input (one message, no traceback, no output file), 3 a solve did not converge
+(reported as such; files are written and flag it), 130 interrupted by Ctrl-C or SIGTERM (the finished steps are
+written; -resume continues).
 """
 
 from contextlib import contextmanager
@@ -43,18 +42,14 @@ def all_options():
 
 def format_help(title, option_table):
     """Lines of -help for a table of ``(name, default, help)``."""
-    lines = [title]
-    for name, default, text in option_table:
-        lines.append(f"  -{name} <{default}>: {text}")
-    return "\n".join(lines)
+    return "\n".join([title] + [f"  -{name} <{default}>: {text}" for name, default, text in option_table])
 
 
 def presets_help():
     """The -help block listing the preset files."""
-    lines = [f"Presets (-options_file FOLDER/NAME.opts; looked up in the current folder, then in {ROOT}):"]
-    for folder in PRESET_FOLDERS:
-        lines.append(f"  {folder}/: " + (" ".join(preset_names(folder)) or "(none installed)"))
-    return "\n".join(lines)
+    return "\n".join([f"Presets (-options_file FOLDER/NAME.opts; looked up in the current folder, then in {ROOT}):"]
+                     + [f"  {folder}/: " + (" ".join(preset_names(folder)) or "(none installed)")
+                        for folder in PRESET_FOLDERS])
 
 
 def print_help():
@@ -107,12 +102,11 @@ def held_output(hold):
 def resolve_presets(argv):
     """``argv`` with each ``-options_file PATH`` not found here resolved against :data:`ROOT`.
 
-    PETSc reads the files when it is initialised, so this runs before; a
-    preset named from another folder (``-options_file solvers/pk.opts``) or by
-    its bare name (``-options_file pk``) is found in the repository. Returns
-    ``(argv, message)``: a file found nowhere, or one that is not an options file
-    (:func:`options_file_error`), is dropped from ``argv`` and ``message`` names it
-    (raised once PETSc can report it on rank 0).
+    PETSc reads the files when it is initialised, so this runs before; a preset named from another folder
+    (``-options_file solvers/pk.opts``) or by its bare name (``-options_file pk``) is found in the repository.
+    Returns ``(argv, message)``: a file found nowhere, or one that is not an options file
+    (:func:`options_file_error`), is dropped from ``argv`` and ``message`` names it (raised once PETSc can report
+    it on rank 0).
     """
     resolved, message = list(argv[:1]), None
     items = iter(argv[1:])
@@ -178,10 +172,9 @@ def available_memory():
 def check_memory(reader, comm, mode):
     """Refuse, before anything is allocated, a generated surface too large for this machine's memory.
 
-    The estimate is :data:`PEAK_BYTES_PER_POINT` per grid point held by a
-    rank (a slab of the grid in a solve, a whole surface per rank in stats,
-    a slab per group in an ensemble), summed over the ranks of this host.
-    Surfaces read from a file are not estimated (reading it is the test).
+    The estimate is :data:`PEAK_BYTES_PER_POINT` per grid point held by a rank (a slab of the grid in a solve, a
+    whole surface per rank in stats, a slab per group in an ensemble), summed over the ranks of this host. Surfaces
+    read from a file are not estimated (reading it is the test).
     """
     from mpi4py import MPI
 

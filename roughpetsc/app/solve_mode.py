@@ -6,7 +6,7 @@ of ``roughpetsc.cli``); the rest are read by the solvers themselves from the opt
 This module imports PETSc only when it runs (``-help`` prints its table before PETSc starts).
 """
 
-from dataclasses import dataclass, fields
+from dataclasses import fields, make_dataclass
 import functools
 import os
 import sys
@@ -15,6 +15,7 @@ import numpy as np
 
 from . import adhesion_options as adhesive_options
 from ..errors import UserError
+from .terminal import printer
 from .settings import FFT_EFFORT, FFT_THREADS, GENERAL_OPTIONS, KKT_RTOL, OUTPUT, QUIET, check_fft, check_modulus, check_rtol, options_named, read_table
 
 # Read by read_settings into SolveSettings (besides the loads -pstar, -pbar, -gbar, -pstar_list).
@@ -95,47 +96,21 @@ SOLVER_HELP = """Solvers (PETSc options):
   -tao_monitor, -tao_view, -log_view and every other TAO/KSP/PC option work as usual."""
 
 
-@dataclass(frozen=True)
-class SolveSettings:
-    """What ``-mode solve`` was asked to do, checked; fields are named as the options are.
-
-    ``steps`` are the loads ``(kind, value)`` in solve order, ``kind`` one of ``pstar``, ``pbar``,
-    ``gbar``; ``load_option`` the option that gave them; ``tao_type`` None for Polonsky-Keer.
-    """
-
-    steps: tuple
-    load_option: str
-    E_star: float
-    overwrite: bool
-    kkt_rtol: float
-    json: str
-    output: str
-    output_fields: str
-    resume: bool
-    plot: str
-    progress: str
-    progress_interval: float
-    fft_threads: int
-    fft_effort: str
-    fft_wisdom: str
-    quiet: bool
-    tao_type: object
-    surface_file: str
-    boundary: str = "periodic"
-    hardness: float = None
-    stress_depths: tuple = ()
-    nu: float = 0.3
-    adhesion: object = None
-
-    @property
-    def control(self):
-        """``"displacement"`` for a prescribed mean gap, ``"load"`` otherwise."""
-        return "displacement" if self.steps[0][0] == "gbar" else "load"
-
-    @property
-    def gather_fields(self):
-        """Whether each step's pressure and gap are gathered on rank 0 (a plot or fields in -output)."""
-        return bool(self.plot) or bool(self.stress_depths) or (bool(self.output) and self.output_fields != "none")
+# What ``-mode solve`` was asked to do, checked; fields are named as the options are. ``steps`` are the loads
+# ``(kind, value)`` in solve order, ``kind`` one of ``pstar``, ``pbar``, ``gbar``; ``load_option`` the option that
+# gave them; ``tao_type`` None for Polonsky-Keer; ``hardness`` None for no cap; the rest as read_physics gives them.
+SolveSettings = make_dataclass(
+    "SolveSettings",
+    [("steps", tuple), ("load_option", str)]
+    + [(name, type(default)) for name, default, _ in GENERAL_OPTIONS + SETTINGS_OPTIONS if name != "mode"]
+    + [("tao_type", object), ("surface_file", str), ("boundary", str), ("hardness", float),
+       ("stress_depths", tuple), ("nu", float), ("adhesion", object)],
+    frozen=True, namespace={
+        # "displacement" for a prescribed mean gap, "load" otherwise.
+        "control": property(lambda self: "displacement" if self.steps[0][0] == "gbar" else "load"),
+        # Whether each step's pressure and gap are gathered on rank 0 (a plot or fields in -output).
+        "gather_fields": property(lambda self: bool(self.plot) or bool(self.stress_depths)
+                                  or (bool(self.output) and self.output_fields != "none"))})
 
 
 def load_steps(reader):
@@ -248,14 +223,6 @@ def is_summary_of(json_path, h5_path):
         os.path.realpath(recorded) == os.path.realpath(h5_path)
 
 
-def printer(quiet, comm):
-    """``say(text)``: print on rank 0 unless ``quiet``."""
-    def say(text):
-        if not quiet and comm.Get_rank() == 0:
-            print(text, flush=True)
-    return say
-
-
 class StepLines:
     """The lines of finished steps, printed once the output files hold their step.
 
@@ -265,9 +232,7 @@ class StepLines:
     """
 
     def __init__(self, say, hold):
-        self.say = say
-        self.hold = hold
-        self.pending = []
+        self.say, self.hold, self.pending = say, hold, []
 
     def add(self, text):
         if self.hold:
@@ -513,11 +478,10 @@ def step_line(step):
 def solve_path(settings, solver, record, comm, lines, requests, progress=None):
     """Solve the loads of ``settings.steps`` not yet in ``record``, recording each and checkpointing the files.
 
-    Each step's pressure and gap are gathered on rank 0 for the record when
-    ``settings.gather_fields``, or kept as this rank's rows when every rank writes its rows of the
-    file (``record.first_row``). Every option must have been used once the
-    first solve is done (PETSc reads viewers and converged reasons during and
-    after TAOSolve); the check runs then, before any file is written.
+    Each step's pressure and gap are gathered on rank 0 for the record when ``settings.gather_fields``, or kept
+    as this rank's rows when every rank writes its rows of the file (``record.first_row``). Every option must
+    have been used once the first solve is done (PETSc reads viewers and converged reasons during and after
+    TAOSolve); the check runs then, before any file is written.
 
     Returns True when a stop was requested (``requests``, on any rank): the step that was running is
     dropped, and nothing more is written. ``progress``: the :class:`roughpetsc.kkt.Progress` to tell

@@ -1,23 +1,11 @@
 """The ``stats`` mode: moments, bandwidths, pressure surface and summit PDFs of a surface or an ensemble.
 
-Usage (the lead wires ``python -m roughpetsc -mode stats`` to :func:`run`)::
+Usage::
 
     mpiexec -n 2 python -m roughpetsc -mode stats -options_file options/group01.opts \\
         -stats_ensemble 20 -stats_json g1.json -stats_h5 g1.h5 -stats_plot g1
 
-Ensembles: realisation ``i = 0 .. n-1`` is the fractal surface of the options
-with the white-noise seed :func:`roughpetsc.seeds.surface_seed` ``(-ensemble_seed, i)``, the
-rule of ``-mode ensemble``: the same master seed gives the same surfaces in both
-modes, on any number of ranks. Whole surfaces are dealt to the ranks
-(surface ``i`` on rank ``i % size``); the per-surface values are gathered on
-rank 0, which forms means and standard deviations (sample std, ddof = 1) in
-seed order and sums the integer histogram counts, so any number of ranks
-gives bit-identical results. With ``-stats_ensemble 0`` the one surface named
-by the options (any type, or ``-surface_file``) is characterised.
-
-Every summary quantity is also written per surface (JSON ``per_surface``, HDF5
-dataset ``per_surface/<name>`` in seed order). What the mode prints and writes (the result
-document, the report table, the PDF plots) is :mod:`roughpetsc.stats_output`.
+An ensemble over ranks, and what is written per surface: docs/runtime.md, "Ensembles over ranks".
 """
 
 from dataclasses import asdict, dataclass
@@ -81,11 +69,10 @@ class StatsSettings:
 def read_settings(options):
     """Read and check :data:`OPTIONS` and ``-E_star``; raise :class:`UserError` naming the option."""
     given = mode_settings.read_table(options, OPTIONS)
-    settings = StatsSettings(
-        ensemble=given["stats_ensemble"], ensemble_seed=given["ensemble_seed"], json=given["stats_json"],
-        h5=given["stats_h5"], plot=given["stats_plot"], bin_width=given["stats_bin_width"],
-        fd_scheme=given["stats_fd_scheme"], e_star=mode_settings.check_modulus(options.getReal("E_star", 1.0)),
-        psd=given["stats_psd"], psd_band=psd_band(options, given))
+    settings = StatsSettings(**{name.removeprefix("stats_"): value for name, value in given.items()
+                                if name != "stats_psd_band"},
+                             e_star=mode_settings.check_modulus(options.getReal("E_star", 1.0)),
+                             psd_band=psd_band(options, given))
     if settings.ensemble < 0:
         raise UserError(f"-stats_ensemble must be >= 0, got {settings.ensemble}")
     if settings.ensemble_seed < 0:
@@ -147,8 +134,8 @@ def flatten_moments(label, moments):
 def field_summit_statistics(grid, field, moments, edges, label):
     """Scalars and histogram counts of the summits and heights of one field (``h`` or ``-p_c``).
 
-    ``moments`` are the isotropic finite-difference moments of ``field``
-    ({0, 2, 4: m_n}); they normalise heights (sqrt(m0)) and curvatures (sqrt(m4)).
+    ``moments`` are the isotropic finite-difference moments of ``field`` ({0, 2, 4: m_n}); they normalise heights
+    (sqrt(m0)) and curvatures (sqrt(m4)).
     """
     summits = asperities.find_summits(grid, field)
     xi, kappa_m = asperities.normalised_summits(summits, moments[0], moments[4])
@@ -169,11 +156,10 @@ def field_summit_statistics(grid, field, moments, edges, label):
 def surface_statistics(grid, heights, settings, edges):
     """All per-surface quantities: ``(scalars, counts, psd)``.
 
-    ``scalars``: flat ``{name: float}`` with the directional and isotropic
-    moments of h and p_c by finite differences (``_fd``) and from the spectrum
-    (``_spec``), bandwidths, summit counts and GW inputs (measured and
-    McCool's). ``counts``: ``{name: (bin counts, total)}`` of the dimensionless
-    heights, summit heights and curvatures of h and -p_c. With ``-stats_psd``: ``psd`` the sums of the
+    ``scalars``: flat ``{name: float}`` with the directional and isotropic moments of h and p_c by finite
+    differences (``_fd``) and from the spectrum (``_spec``), bandwidths, summit counts and GW inputs (measured and
+    McCool's). ``counts``: ``{name: (bin counts, total)}`` of the dimensionless heights, summit heights and
+    curvatures of h and -p_c. With ``-stats_psd``: ``psd`` the sums of the
     radially averaged PSD (:func:`roughpetsc.spectra.radial_psd_sums`), and the fit of (2.18)
     (:func:`roughpetsc.spectra.fit_fractal_psd`) among the scalars (``psd_hurst``, ``psd_C``); else None.
     """
@@ -213,9 +199,7 @@ def default_psd_band(grid):
 def surface_seeds(settings):
     """Seeds of the realisations in index order (:func:`roughpetsc.seeds.surface_seeds`); ``[None]`` for the
     single surface of the options."""
-    if settings.ensemble == 0:
-        return [None]
-    return seeds.surface_seeds(settings.ensemble_seed, settings.ensemble)
+    return [None] if settings.ensemble == 0 else seeds.surface_seeds(settings.ensemble_seed, settings.ensemble)
 
 
 def local_statistics(options, settings, seeds, edges, rank, size, levelling=None):
@@ -236,15 +220,12 @@ def gather_in_seed_order(comm, results_or_error):
     """Gather every rank's results (or the message of its error, a str) on rank 0 and sort them by surface
     index; raise any rank's error as a :class:`UserError`.
 
-    Returns the ordered list on rank 0 and None elsewhere; every rank raises
-    the same :class:`UserError` if any rank failed.
+    Returns the ordered list on rank 0 and None elsewhere; every rank raises the same :class:`UserError` if any
+    rank failed.
     """
     gathered = comm.gather(results_or_error, root=0)
-    message = None
-    if comm.rank == 0:
-        errors = [item for item in gathered if isinstance(item, str)]
-        message = errors[0] if errors else None
-    message = comm.bcast(message, root=0)
+    first_error = next((item for item in gathered if isinstance(item, str)), None) if comm.rank == 0 else None
+    message = comm.bcast(first_error, root=0)
     if message is not None:
         raise UserError(message)
     if comm.rank != 0:
@@ -258,9 +239,8 @@ def ensemble_summary(ordered, edges):
     table = {name: np.array([entry[2][name] for entry in ordered]) for name in names}
     mean = {name: float(np.mean(values)) for name, values in table.items()}
     std = {name: float(np.std(values, ddof=1)) if values.size > 1 else 0.0 for name, values in table.items()}
-    pooled = {}
-    for name in ordered[0][3]:
-        pooled[name] = (sum(entry[3][name][0] for entry in ordered), sum(entry[3][name][1] for entry in ordered))
+    pooled = {name: (sum(entry[3][name][0] for entry in ordered), sum(entry[3][name][1] for entry in ordered))
+              for name in ordered[0][3]}
     psd = None
     if ordered[0][5] is not None:  # the PSD sums in seed order
         psd = {name: sum(entry[5][name] for entry in ordered) for name in ordered[0][5]}

@@ -18,6 +18,14 @@ LAUNCHER_NAMES = ("mpiexec", "mpirun", "orterun", "prterun", "mpiexec.hydra", "m
                   "mpiexec.mpich", "mpirun.mpich")
 
 
+def printer(quiet, comm):
+    """``say(text)``: print on rank 0 unless ``quiet``."""
+    def say(text):
+        if not quiet and comm.Get_rank() == 0:
+            print(text, flush=True)
+    return say
+
+
 def under_launcher(environ=os.environ):
     """True when this process was started by an MPI launcher."""
     return any(name in environ for name in LAUNCHER_VARIABLES)

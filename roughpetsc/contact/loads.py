@@ -7,17 +7,8 @@ n2 = 45 and n3 = 20 sub-steps::
     p*_i = exp(ln 0.2 + D2 (i - 30))        30 < i <= 75
     p*_i = 2 + D3 (i - 75)                  75 < i <= 95
 
-with D2 = 0.0512 and D3 = 0.1. The dissertation prints D1 = 0.067, which contradicts
-its own early stage (0, 0.2] with 30 steps (30 * 0.067 = 2.01); following the
-erratum in docs/conventions.md we use D1 = 0.2 / 30, so the first stage ends at
-exactly 0.2 and joins the second.
-
-The second stage does not end at exactly 2: 0.2 exp(0.0512 * 45) =
-0.2 exp(2.304) = 2.00283..., slightly above the third stage's origin 2, so
-step 75 (2.00283) and step 76 (2.1) are 0.0972 apart instead of 0.1. The
-history is nevertheless strictly increasing and ends at p*_95 = 4. We keep
-the dissertation's D2 as printed (D2 = ln(10) / 45 = 0.051168... would end exactly
-at 2).
+with D1 = 0.2 / 30 (erratum of (7.11) in docs/conventions.md, which also notes where the second stage ends),
+D2 = 0.0512 and D3 = 0.1; the history is strictly increasing and ends at p*_95 = 4.
 """
 
 import math

@@ -7,11 +7,9 @@ Westergaard compliance (3.33) or the free boundary's Love coefficients (3.31).
 from ..lazy import exports
 
 __getattr__, __dir__, __all__ = exports(__name__, {
-    "BOUNDARIES": ("factory", "BOUNDARIES"),
-    "make_operator": ("factory", "make_operator"),
-    "FilterOperator": ("operator", "FilterOperator"),
-    "Westergaard": ("westergaard", "Westergaard"),
-    "FreeBoundary": ("love", "FreeBoundary"),
-    "periodic_stresses": ("stresses", "periodic_stresses"),
-    "free_stresses": ("stresses", "free_stresses"),
+    "factory": "BOUNDARIES make_operator",
+    "operator": "FilterOperator",
+    "westergaard": "Westergaard",
+    "love": "FreeBoundary",
+    "stresses": "periodic_stresses free_stresses",
 })

@@ -1,13 +1,6 @@
 """The run of ``-mode ensemble``: groups of ranks solve whole surfaces; world rank 0 keeps the file.
 
-* COMM_WORLD is split into groups of ``-ensemble_group_ranks`` ranks; each group solves whole surfaces
-  on its own communicator, the next one drawn from the work counter (:mod:`.scheduler`).
-* Surface ``i`` is the fractal surface of the ``-surface_*`` options with the white-noise seed of
-  :func:`roughpetsc.seeds.surface_seed` ``(ensemble_seed, i)``, solved along the loads in order, each
-  step warm-started from the previous one (load control, the solver of the PETSc options).
-* Leaders send each finished surface to rank 0, which looks for them between its own load steps and
-  rewrites the whole file after every finished surface (:mod:`roughpetsc.store.ensemble_file`,
-  atomically). Resume keeps the finished surfaces of an existing file of the same configuration.
+How groups, surfaces and the file fit together: docs/runtime.md, "Ensembles over ranks".
 """
 
 import json
@@ -18,6 +11,7 @@ import traceback
 
 import numpy as np
 
+from ..app.terminal import printer
 from ..store import outputs as io
 from ..errors import UserError
 from ..surface.seeds import RULE as SEED_RULE, surface_seed
@@ -145,7 +139,7 @@ class Ensemble:
         self.reader, self.s, self.config = reader, s, config
         self.comm = comm.Dup()               # our own messages never meet PETSc's or mpi4py-fft's
         self.rank, self.size = self.comm.Get_rank(), self.comm.Get_size()
-        self.quiet = s.quiet
+        self.say = printer(s.quiet, comm)  # print on rank 0 unless -quiet
         self.records, self.runs, self.wisdom, error = [], [], "", None
         if self.rank == 0:
             try:
@@ -196,10 +190,6 @@ class Ensemble:
         io.on_root(self.comm, self.write)  # a file rank 0 cannot write stops every rank, not rank 0 alone
 
     # --- rank 0: file and progress -------------------------------------------
-    def say(self, text):
-        if not self.quiet and self.rank == 0:
-            print(text, flush=True)
-
     def write(self, models=None):
         attrs = dict(self.attrs, complete=len(self.records) == self.s.size, runs=json.dumps(self.runs))
         records = sorted(self.records, key=lambda r: r["surface"]["index"])

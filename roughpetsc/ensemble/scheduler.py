@@ -1,9 +1,6 @@
 """The work counter of an ensemble: which surface a group solves next (dynamic scheduling over ranks).
 
-Group leaders draw the next unfinished surface from an atomic counter on world rank 0: MPI one-sided
-``Fetch_and_op`` on a window when the MPI library offers a usable one, otherwise by a message to rank 0,
-which answers between its own load steps. Surfaces are handed out in index order, first come first served,
-so a fast group takes more of them; the file is kept in index order whatever the order of completion.
+The counter and its two transports: docs/runtime.md, "Ensembles over ranks".
 """
 
 import numpy as np

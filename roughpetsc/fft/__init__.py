@@ -7,10 +7,8 @@ field (:meth:`filter`). The elastic operators (:mod:`roughpetsc.elastic`) are bu
 from ..lazy import exports
 
 __getattr__, __dir__, __all__ = exports(__name__, {
-    "planner_effort": ("plans", "planner_effort"),
-    "wisdom_path": ("plans", "wisdom_path"),
-    "remembered_plans": ("plans", "remembered_plans"),
-    "SerialTransform": ("serial", "SerialTransform"),
-    "SlabTransform": ("slab", "SlabTransform"),
-    "PaddedTransform": ("padded", "PaddedTransform"),
+    "plans": "planner_effort wisdom_path remembered_plans",
+    "serial": "SerialTransform",
+    "slab": "SlabTransform",
+    "padded": "PaddedTransform",
 })

@@ -5,12 +5,9 @@ f(p*) = a exp(b p*) + c exp(d p*) with a = -c (so that A*(0) = 0; erratum of doc
 sentence after Table 8.4 gives the column means of b, c, d under the names a, b, c).  Continuity at p* = 2
 requires c = 1 / (exp(2 d) - exp(2 b)).
 
-Which model is I (``model=``): section 8.5 names the Greenwood model (5.45) with the PDF (2.41), but the
-printed b, c, d of Table 8.4 are not its. They are reproduced from our 50-surface ensembles with the adapted
-GW model of nearly complete contact (5.37) and the summit PDF (2.42) (erratum of docs/conventions.md;
-studies/output/table_8_4/table_8_4.md lists every reading tried). So the default I is ``"gw"``, (5.37);
-``"greenwood"`` is (5.45) as the text names it, and ``"nayak_bush"`` (5.41) and ``"ciavarella"`` (5.54) are
-the chapter's other nearly-complete models. A callable ``I(p*)`` serves any other reading.
+Which model is I (``model=``): by default ``"gw"``, the adapted GW model (5.37) with the summit PDF
+(2.42), the one that reproduces Table 8.4, not the Greenwood model (5.45) that section 8.5 names (erratum of
+docs/conventions.md); see :func:`curvefit_reference` for the others.
 
 Section 8.5 notes that the slope of the fit at p* = 0 should be the asymptotic BGT model's sqrt(pi/2), and
 that (8.3) with two free parameters does not hold it. Held as a third condition, I(0) c (d - b) = sqrt(pi/2)

@@ -1,22 +1,7 @@
 """One shared, vectorised composite Gauss-Legendre rule (the dissertation, section 4.4).
 
-Every integral of the statistical models is evaluated with :func:`gauss_legendre`
-on a finite, transformed domain.  The dissertation (section 4.4) maps the semi-infinite
-summit-height range with ``x = 1/xi`` and the curvature ranges with
-``y = exp(-kappa)``.  Two refinements of the same idea are used here:
-
-* ``x = 1/xi`` is singular at the separation ``d* = 0`` (a row of Tables 4.1/4.2)
-  and leaves the endpoint singularities ``(xi - d)**(3/2)``, ``(xi - d)**(5/2)``
-  and ``kappa**(1/2)`` in the integrand.  :func:`semi_infinite` therefore uses the
-  algebraic map ``t = scale * ((1 - u) / u)**power`` with ``u`` in ``(0, 1]``
-  (``power = 1`` is the dissertation's ``x = 1/xi`` shifted to the lower limit;
-  ``power = 2`` additionally makes every half-integer power of ``t`` smooth in
-  ``u``), so that Gauss-Legendre converges exponentially.
-* The curvature ratio ``y = kappa_1/kappa_2`` of the BGT model carries a
-  ``y**(1/2)`` factor; :func:`unit_interval` maps ``y = w**power``.
-
-The accuracy is controlled only by the number of elements (and the fixed order,
-8 points per element by default); nothing is adaptive per evaluation point.
+Every integral of the statistical models is evaluated with :func:`gauss_legendre` on a finite, transformed
+domain; the maps and why: docs/models.md, "Quadrature (`quadrature`)".
 """
 
 import numpy as np

@@ -1,38 +1,6 @@
 """The two protocols of the solver layer: what a problem offers the solvers, and what a backend offers the facade.
 
-**A problem** (:class:`~roughpetsc.contact.ContactProblem`, :class:`~roughpetsc.contact.AdhesiveProblem`):
-
-``kind``
-    The registry's key of its backends (``"contact"``, ``"adhesive"``).
-``controls``
-    The controls it is solved under (``"load"``, ``"displacement"``).
-``comm``, ``mpi``, ``n``, ``operator``, ``vec()``, ``local(vec)``
-    The layout of its unknown: a PETSc Vec distributed by grid rows.
-``target(control, pbar=, pstar=, gbar=)``
-    The prescribed load or mean gap in the problem's scaled units, checked (ParameterError naming it).
-``continuation(keeps_displacement)``
-    The object that holds the unknown (``.unknown``), starts each solve from the previous solutions
-    (``start(target, start) -> Guess``) and remembers the certified ones (``record(target, outcome, work)``).
-``exact(target, control, unknown)``
-    An :class:`Outcome` where the answer is known in closed form (complete contact), else None.
-``certify(unknown, work, outcome, target, control, rtol, solver, started, applications) -> Result``
-    The result of the unknown, its KKT residual computed afresh (into the scratch Vec ``work``).
-``fields(unknown, work, result)``
-    This rank's rows of the pressure and the gap in the problem's units.
-
-**A backend** solves one problem kind for one target:
-
-``solve(target, unknown, guess) -> Outcome``
-    ``target`` as the problem's ``target`` gives it; ``unknown`` is the Vec the backend updates in place
-    (it holds the start); ``guess`` (:class:`Guess`) is what the facade knows about the start.
-``destroy()``, ``name`` (the solver's name in results), ``tao`` (its TAO object, for monitors).
-
-Optional behaviour is an attribute with a default here, never a type check in the facade:
-``keeps_displacement`` asks the continuation to keep K p of its solutions along a load path, so that
-:class:`Guess` can carry K p of the next start; an :class:`Outcome` with ``confirmed=False`` (allowed
-by ``Guess.confirm=False``) asks the facade to solve again with ``Guess(confirm=True)`` when its
-certificate fails (the resume of Polonsky-Keer along a load path); ``unusable_options()`` lists options
-given for parts the backend never runs.
+The protocols in full: docs/solvers.md, "The protocols (`solvers/protocol.py`)".
 """
 
 from dataclasses import dataclass

@@ -1,10 +1,10 @@
 """Result files: checks of output paths, atomic replacement, JSON, versions and provenance.
 
-Files are written by rank 0 to a temporary name in the same folder and renamed
-at the end (:class:`atomic_path`), so a failed or killed run leaves no half-written
-file. HDF5 files are written by :mod:`roughpetsc.store`.
+Files are written by rank 0 to a temporary name in the same folder and renamed at the end (:class:`atomic_path`),
+so a failed or killed run leaves no half-written file. HDF5 files are written by :mod:`roughpetsc.store`.
 """
 
+from contextlib import suppress
 import json
 import os
 import re
@@ -35,10 +35,8 @@ def versions():
         "python": sys.version.split()[0],
     }
     for module in ("pyfftw", "mpi4py_fft", "h5py"):
-        try:
+        with suppress(ImportError, AttributeError):
             found[module] = __import__(module).__version__
-        except (ImportError, AttributeError):
-            pass
     return found
 
 
@@ -52,9 +50,8 @@ def provenance():
 def check_writable(path, option):
     """Fail early, naming the option, if a file cannot be written at ``path``.
 
-    Refused: a folder, a folder that does not exist or takes no new file (tried
-    by creating one, which also catches read-only file systems and root), an
-    existing file without write permission.
+    Refused: a folder, a folder that does not exist or takes no new file (tried by creating one, which also catches
+    read-only file systems and root), an existing file without write permission.
     """
     if os.path.isdir(path):
         raise UserError(f"-{option} {path}: is a folder; give a file name")
@@ -122,9 +119,8 @@ def check_figure_format(path, option):
 def on_root(comm, action, *args):
     """Run ``action(*args)`` on rank 0 only; its :class:`UserError` is raised on every rank.
 
-    What only rank 0 does (checking or writing files) must not fail there
-    alone: the other ranks would wait for ever in their next collective call.
-    The error message is broadcast, so every rank raises the same error (and
+    What only rank 0 does (checking or writing files) must not fail there alone: the other ranks would wait for
+    ever in their next collective call. The error message is broadcast, so every rank raises the same error (and
     all ranks leave together). Returns the result on rank 0, None elsewhere.
     """
     result, message = None, None
@@ -150,18 +146,14 @@ def file_mode():
 class atomic_path:
     """Context manager giving a temporary path (same folder, same suffix) that replaces ``path`` on success only.
 
-    The file gets the mode of any new file (:func:`file_mode`; mkstemp's would
-    be 0600). ``durable``: fsync the file and its folder, so that a crash right
-    after leaves the old or the new file, whole. ``deferred``: a list; on success the
-    written temporary joins it instead of replacing ``path``, for the caller to :meth:`replace`
-    several files at once (or :meth:`discard` them). A failure to write raises
-    :class:`UserError` naming ``path``.
+    The file gets the mode of any new file (:func:`file_mode`; mkstemp's would be 0600). ``durable``: fsync the
+    file and its folder, so that a crash right after leaves the old or the new file, whole. ``deferred``: a list; on
+    success the written temporary joins it instead of replacing ``path``, for the caller to :meth:`replace` several
+    files at once (or :meth:`discard` them). A failure to write raises :class:`UserError` naming ``path``.
     """
 
     def __init__(self, path, durable=False, deferred=None):
-        self.path = path
-        self.durable = durable
-        self.deferred = deferred
+        self.path, self.durable, self.deferred = path, durable, deferred
         folder = os.path.dirname(os.path.abspath(path))
         try:
             handle, self.temporary = tempfile.mkstemp(prefix=".tmp-", suffix=os.path.basename(path), dir=folder)
@@ -217,9 +209,7 @@ class atomic_path:
 def _os_reason(error):
     """The system's words for an OSError, also when HDF5 wrapped them in its own long message."""
     found = re.search(r"error message = '([^']+)'", str(error))
-    if found:
-        return found.group(1)
-    return error.strerror or str(error).splitlines()[0]
+    return found.group(1) if found else error.strerror or str(error).splitlines()[0]
 
 
 def remove_stale_temporaries(path):
@@ -231,10 +221,8 @@ def remove_stale_temporaries(path):
     suffix = os.path.basename(path)
     for name in os.listdir(folder):
         if name.startswith(".tmp-") and name.endswith(suffix) and len(name) > len(".tmp-") + len(suffix):
-            try:
+            with suppress(OSError):
                 os.remove(os.path.join(folder, name))
-            except OSError:
-                pass
 
 
 def _fsync(path):

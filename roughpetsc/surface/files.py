@@ -17,25 +17,22 @@ from ..errors import ParameterError
 def load(path):
     """Read a surface from ``.npy``, HDF5, CSV or a text file.
 
-    HDF5: the dataset ``surface`` (contact-mechanics-challenge layout) or
-    ``heights`` (a roughpetsc output, whose root attribute ``length`` records
-    the cell size ``[l0, l1]``). Other suffixes than those of :data:`TABLE_SUFFIXES`
-    are instrument files, read by SurfaceTopography (:func:`read_instrument`).
-    CSV (``.csv``, commas) and text (blanks) hold
-    a height matrix (rows along y, at least 4 columns) or an ``x y z`` point
-    list (three columns, one point a line) whose points lie on a uniform grid of
-    square nodes (:func:`points_to_grid`); one header line of words is skipped.
+    HDF5: the dataset ``surface`` (contact-mechanics-challenge layout) or ``heights`` (a roughpetsc output, whose
+    root attribute ``length`` records the cell size ``[l0, l1]``). Other suffixes than those of
+    :data:`TABLE_SUFFIXES` are instrument files, read by SurfaceTopography (:func:`read_instrument`). CSV
+    (``.csv``, commas) and text (blanks) hold a height matrix (rows along y, at least 4 columns) or an ``x y z``
+    point list (three columns, one point a line) whose points lie on a uniform grid of square nodes
+    (:func:`points_to_grid`); one header line of words is skipped.
 
     Returns
     -------
     heights : ndarray (n0, n1), length units, zero mean.
     length : float or None
-        The recorded cell length along axis 1 (x), length units: that of a roughpetsc
-        file, or the number of columns times the node spacing of a point list; None
-        if the file does not record one.
+        The recorded cell length along axis 1 (x), length units: that of a roughpetsc file, or the number of
+        columns times the node spacing of a point list; None if the file does not record one.
 
-    Raises :class:`ParameterError` (parameter ``path``) naming the file if it
-    is missing, unreadable or not a finite 2-D array.
+    Raises :class:`ParameterError` (parameter ``path``) naming the file if it is missing, unreadable or not a
+    finite 2-D array.
     """
     if not os.path.isfile(path):
         raise ParameterError("path", f"no such file: {path}")
@@ -246,8 +243,6 @@ class Levelling:
 # an rms jump, many times those of neighbours; warned of when also above this fraction of the rms height (a tilt
 # took alpha_h of a measured surface from 2.5 to 61).
 EDGE_WARNING = 0.25
-
-
 # ... and this many times the neighbours' rms step (jump) or the rms over the columns of their mean step (rise).
 EDGE_STEPS = 5.0
 
@@ -316,8 +311,8 @@ def level(grid, heights, how="mean"):
 def validate(heights):
     """Check a height array and return it as float64 with zero mean.
 
-    Raises :class:`ParameterError` (parameter ``heights``) for anything but a
-    finite, real, non-flat 2-D array of at least 2x2 nodes.
+    Raises :class:`ParameterError` (parameter ``heights``) for anything but a finite, real, non-flat 2-D array of
+    at least 2x2 nodes.
     """
     heights = np.asarray(heights)
     if heights.ndim != 2 or min(heights.shape) < 2:

@@ -379,9 +379,7 @@ def pressure_surface(grid, heights, e_star=1.0):
     of the dissertation is ``-p_c``. The solver applies the same symbol
     distributed over the ranks (:meth:`roughpetsc.westergaard.Westergaard.pressure_surface`).
     """
-    spectrum = np.fft.rfft2(heights)
-    spectrum *= complete_contact_symbol(grid, e_star)
-    return np.fft.irfft2(spectrum, s=grid.shape)
+    return np.fft.irfft2(np.fft.rfft2(heights) * complete_contact_symbol(grid, e_star), s=grid.shape)
 
 
 def complete_contact_symbol(grid, e_star):
