@@ -241,8 +241,8 @@ def report(rows, profile, folder):
              "residual floors of tao_floors.py) and was not rerun at N = 1024 (`--solvers blmvm bqnls tron`). "
              "The PK, BLMVM and BQNLS `after` rows are of the penalty 0.1, unrecycled memory and inner "
              "tolerance 0.3 (`--solvers blmvm bqnls`); the TRON and GPCG `after` rows were not rerun "
-             "(commit 4ed21eb, contact stiffness to 0.1 % and inner tolerance 0.1 then: TRON takes 478, 557, 471 "
-             "pairs at N = 512 now), so their `x PK` columns divide by the later PK run.", ""] + TRIED
+             "(commit 4ed21eb, contact stiffness to 0.1 % then; their inner tolerance is still 0.1), so their "
+             "`x PK` columns divide by the later PK run.", ""] + TRIED
     if rows:
         lines += ["## Every solve", "", grid_table(rows), "", f"![time and pairs]({plot(rows, folder)})", ""]
     if profile:
