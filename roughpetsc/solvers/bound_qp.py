@@ -20,9 +20,9 @@ solution: first by a Newton step with the contact stiffness k = -dP/dd = 1_C' K_
 solution (:func:`contact_stiffness`, a preconditioned CG on its contact set to 1 % in k, 7 to 11 operator
 applications; ``-bound_al_newton false``: the method of multipliers, lambda <- d), then by secants on (d, log P),
 kept inside the bracket the pairs give. The inner solves are inexact: one stops once its natural residual is below
-``-bound_al_eta`` (0.3 for the quasi-Newton types with the Fourier H0, 0.1 for the others) times its load error (the stopping rule's ``inner_eta``); only the last is solved to the
-tolerance (0.3 against 0.1: 3-19 % fewer pairs for BLMVM and BQNLS in 11 of 12 loads at N = 512 and 1024, 9 % more
-in one). The penalty c is in units of the compliance of the longest wavelength, L / pi (``-bound_al_penalty``):
+``-bound_al_eta`` times its load error (the stopping rule's ``inner_eta``): 0.3 for the quasi-Newton types with the
+Fourier H0, 0.1 for the others; only the last is solved to the tolerance (0.3 against 0.1: 3-19 % fewer pairs
+for BLMVM and BQNLS in 11 of 12 loads at N = 512 and 1024, 9 % more in one). The penalty c is in units of the compliance of the longest wavelength, L / pi (``-bound_al_penalty``):
 0.1 for the quasi-Newton types with the Fourier H0 (their first inner solve, at a poor lambda, is then cheap and
 the Newton step mends the load), 1 for the others. Penalties of 10 and more stall BLMVM and BQNLS near the start
 (natural residual about 3 after 1000 pairs, failed line searches), likely as the projection of each trial onto

@@ -35,8 +35,9 @@ from .stopping import ConvergenceTest, History, Verdict, check_convergence, desc
 REFRESH = 50  # recompute S g at least every REFRESH iterations (the update S g -= step S t drifts)
 ARMIJO = 1e-4
 MAX_BACKTRACKS = 40
-# A fall of the energy by this fraction of the work of adhesion (over the surface) since the last counts as progress (it restarts
-# the stagnation count): far above the round-off floor, where steps change the energy by residual^2.
+# A fall of the energy by this fraction of the work of adhesion (over the surface) since the last counts as
+# progress (it restarts the stagnation count): far above the round-off floor, where steps change the energy by
+# residual^2.
 ENERGY_PROGRESS = 1e-10
 
 
