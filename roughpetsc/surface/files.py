@@ -15,24 +15,14 @@ from ..errors import ParameterError
 
 
 def load(path):
-    """Read a surface from ``.npy``, HDF5, CSV or a text file.
+    """Read a surface from ``.npy``, HDF5, CSV, text or an instrument file: ``(heights, length)``.
 
-    HDF5: the dataset ``surface`` (contact-mechanics-challenge layout) or ``heights`` (a roughpetsc output, whose
-    root attribute ``length`` records the cell size ``[l0, l1]``). Other suffixes than those of
-    :data:`TABLE_SUFFIXES` are instrument files, read by SurfaceTopography (:func:`read_instrument`). CSV
-    (``.csv``, commas) and text (blanks) hold a height matrix (rows along y, at least 4 columns) or an ``x y z``
-    point list (three columns, one point a line) whose points lie on a uniform grid of square nodes
-    (:func:`points_to_grid`); one header line of words is skipped.
-
-    Returns
-    -------
-    heights : ndarray (n0, n1), length units, zero mean.
-    length : float or None
-        The recorded cell length along axis 1 (x), length units: that of a roughpetsc file, or the number of
-        columns times the node spacing of a point list; None if the file does not record one.
-
-    Raises :class:`ParameterError` (parameter ``path``) naming the file if it is missing, unreadable or not a
-    finite 2-D array.
+    HDF5: the dataset ``surface`` (contact-mechanics-challenge layout) or ``heights`` (a roughpetsc output, its
+    root attribute ``length`` = ``[l0, l1]``). Suffixes outside :data:`TABLE_SUFFIXES` are instrument files
+    (:func:`read_instrument`). CSV and text hold a height matrix (rows along y, >= 4 columns) or an ``x y z``
+    point list (:func:`points_to_grid`). ``heights`` [length] have zero mean; ``length`` is the recorded cell
+    length along x, or None. Raises :class:`ParameterError` (``path``) naming the file if it is missing,
+    unreadable or not a finite 2-D array.
     """
     if not os.path.isfile(path):
         raise ParameterError("path", f"no such file: {path}")
@@ -48,13 +38,10 @@ def load(path):
         raise ParameterError("path", f"{path}: {error}") from None
 
 
-# Files read as tables (a height matrix or an x y z point list) by their suffix; HDF5 and .npy by their own
-# readers; any other suffix by SurfaceTopography when that optional extra is installed (tools/surfacetopography.sh).
 TABLE_SUFFIXES = (".txt", ".csv", ".dat", ".asc", ".xyz", "")
 
 
 def _read_array(path):
-    """``(heights as stored, recorded length or None)`` of a surface file, by its suffix."""
     suffix = os.path.splitext(path)[1].lower()
     if suffix == ".npy":
         return np.load(path, allow_pickle=False), None
@@ -76,9 +63,7 @@ def _read_array(path):
 def read_instrument(path):
     """``(heights, cell length along x or None)`` of an instrument file, read by SurfaceTopography.
 
-    Rows of the result run along y. The length is the file's physical size along x (in the unit of
-    its heights), None where the file records none. Without SurfaceTopography (an optional extra,
-    ``bash tools/surfacetopography.sh``) the file is read as a table if it is one, else refused.
+    Rows run along y. Without SurfaceTopography (``bash tools/surfacetopography.sh``) a table is still read.
     """
     try:
         from SurfaceTopography import open_topography
@@ -107,10 +92,7 @@ def read_instrument(path):
 
 
 def read_table(path):
-    """The numbers of a CSV or text file as a 2-D array; ``#`` comments and one header line of words are skipped.
-
-    The delimiter is the comma for ``.csv`` and for a file whose first line of numbers has one, else blanks.
-    """
+    """The numbers of a CSV or text file as a 2-D array; ``#`` comments and one header line are skipped."""
     with open(path) as handle:
         lines = [line.split("#", 1)[0].strip() for line in handle]
     lines = [line for line in lines if line]
@@ -133,7 +115,8 @@ def read_table(path):
             raise ParameterError("path", f"a line of data is not numbers: '{line[:60]}'") from None
     widths = {len(row) for row in rows}
     if len(widths) != 1:
-        raise ParameterError("path", f"the lines hold different numbers of values ({', '.join(map(str, sorted(widths)))})")
+        raise ParameterError("path", "the lines hold different numbers of values "
+                                     f"({', '.join(map(str, sorted(widths)))})")
     return np.array(rows, dtype=float).reshape(len(rows), widths.pop())
 
 
@@ -148,7 +131,6 @@ def table_surface(table, path):
 
 
 def _axis_nodes(values, name):
-    """The distinct coordinates ``values`` of a point list along one axis, checked to be equally spaced."""
     nodes = np.unique(values)
     if nodes.size < 2:
         raise ParameterError("path", f"the points of the x y z list have a single {name} coordinate")
@@ -163,9 +145,7 @@ def _axis_nodes(values, name):
 def points_to_grid(points):
     """The heights of an ``x y z`` point list on a uniform grid of square nodes: ``(heights, cell length along x)``.
 
-    Every node of the grid must be given exactly once; rows of the result run along y (axis 0),
-    columns along x. The cell is the grid's extent plus one spacing (the periodic cell repeats
-    the nodes). Raises :class:`ParameterError` with the figures when the points do not lie on such a grid.
+    Every node must be given once; rows run along y. The cell is the grid's extent plus one spacing.
     """
     x_nodes, dx = _axis_nodes(points[:, 0], "x")
     y_nodes, dy = _axis_nodes(points[:, 1], "y")
@@ -191,11 +171,7 @@ DETRENDS = ("none", "mean", "plane")
 
 
 def fit_plane(grid, heights):
-    """The least-squares plane of ``heights`` over the nodes: ``(mean, slope along x, slope along y)``.
-
-    Slopes in length / length; the plane is ``mean + slope_x (x - xc) + slope_y (y - yc)`` about the
-    cell's centre of nodes (xc, yc).
-    """
+    """The least-squares plane ``mean + slope_x (x - xc) + slope_y (y - yc)`` about the nodes' centre."""
     y, x = grid.coordinates()
     x = np.broadcast_to(x - x.mean(), grid.shape)
     y = np.broadcast_to(y - y.mean(), grid.shape)
@@ -213,13 +189,8 @@ def plane_heights(grid, slope_x, slope_y):
 
 @dataclass(frozen=True)
 class Levelling:
-    """What :func:`level` did to a measured surface and what it found, with the figures of its warnings.
-
-    ``slope_x``, ``slope_y``: the least-squares plane's slopes; ``removed``: whether it was removed;
-    ``tilt_rms``: the rms of that plane over the cell; ``rms``: the rms height of the surface used;
-    ``edge_jump``: :func:`edge_jumps` of the surface used; ``notes``: the lines to print (``warning: ...``
-    for a warning).
-    """
+    """What :func:`level` did to a measured surface and found: the plane's slopes, whether it was removed, its
+    rms ``tilt_rms``, the surface's ``rms``, its :func:`edge_jumps` and the ``notes`` to print."""
 
     how: str
     slope_x: float
@@ -238,21 +209,18 @@ class Levelling:
                 "notes": list(self.notes)}
 
 
-# Edges are compared with neighbouring nodes: a periodic surface steps from its last column (row) to its first as
-# from any column to the next. A tilt makes that step a rise of the whole cell, a measurement that is not periodic
-# an rms jump, many times those of neighbours; warned of when also above this fraction of the rms height (a tilt
-# took alpha_h of a measured surface from 2.5 to 61).
+# A tilt or a non-periodic measurement makes the step from the last column (row) to the first many times that
+# between neighbours; warned of when also above this fraction of the rms height (a tilt took a measured
+# surface's alpha_h from 2.5 to 61).
 EDGE_WARNING = 0.25
 # ... and this many times the neighbours' rms step (jump) or the rms over the columns of their mean step (rise).
 EDGE_STEPS = 5.0
 
 
 def edge_jumps(heights):
-    """``{"x": (rise, rms mean step, jump, rms step), "y": ...}``: the last column (row) against the first.
+    """``{"x": (rise, rms mean step, jump, rms step), "y": ...}`` [length]: the last column (row) against the first.
 
-    ``rise`` is the mean of last - first (a tilt across the cell), ``jump`` the rms of that difference;
-    ``rms mean step`` is the rms over neighbouring columns (rows) of their mean difference, ``rms step``
-    the rms of their differences: what a periodic surface's edges would show. Length units.
+    ``rise``, ``jump``: mean and rms of last - first; the steps: the same between neighbours.
     """
     found = {}
     for axis, name in ((1, "x"), (0, "y")):
@@ -267,13 +235,10 @@ def edge_jumps(heights):
 
 
 def level(grid, heights, how="mean"):
-    """Level a measured surface: ``(heights, Levelling)``.
+    """Level a measured surface: ``(heights, Levelling)``, the heights with zero mean (:func:`validate`).
 
-    ``how``: ``none`` (as given), ``mean`` (the mean removed; the contact does not see it, the operator
-    has no k = 0 mode) or ``plane`` (the least-squares plane removed, :func:`fit_plane`). The heights
-    returned have zero mean whatever ``how`` (:func:`validate`). The notes report the plane removed,
-    and warn, with the figures, when a tilt left in place or a jump between opposite edges (a
-    measurement that is not periodic: the cell repeats it with a step) is large against the rms height.
+    ``how``: ``none``, ``mean`` or ``plane`` (:func:`fit_plane` removed). The notes warn when a tilt left in
+    place or a jump between opposite edges is large against the rms height.
     """
     if how not in DETRENDS:
         raise ParameterError("detrend", f"the levelling is one of {', '.join(DETRENDS)}, got '{how}'")
@@ -309,11 +274,7 @@ def level(grid, heights, how="mean"):
 
 
 def validate(heights):
-    """Check a height array and return it as float64 with zero mean.
-
-    Raises :class:`ParameterError` (parameter ``heights``) for anything but a finite, real, non-flat 2-D array of
-    at least 2x2 nodes.
-    """
+    """Check a height array (finite, real, non-flat, 2-D, >= 2x2) and return it as float64 with zero mean."""
     heights = np.asarray(heights)
     if heights.ndim != 2 or min(heights.shape) < 2:
         raise ParameterError("heights", "a surface must be a 2-D array with at least 2x2 nodes, "

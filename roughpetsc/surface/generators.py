@@ -1,14 +1,8 @@
 """Generated periodic surfaces on a uniform grid: self-affine fractals (7.1)-(7.5), bisinusoid (3.52), wave, sphere.
 
-Array layout: a surface is a real array of shape ``(n0, n1)``; axis 0 ("rows",
-``y``) is the one distributed over MPI ranks, axis 1 (``x``) is contiguous.
-Heights are returned with zero mean (docs/conventions.md). Wavenumbers are in
-cycles per length, as in the Fourier pair (2.1)/(2.2) of the dissertation.
-
-Bad values raise :class:`~roughpetsc.errors.ParameterError` naming the Python
-parameter; the command line names the option (``roughpetsc.cli``).
+A surface is a real ``(n0, n1)`` array with zero mean, axis 0 (rows, ``y``) distributed over the ranks; wavenumbers
+in cycles per length (2.1)/(2.2). Bad values raise :class:`~roughpetsc.errors.ParameterError` naming the parameter.
 """
-
 
 import numpy as np
 
@@ -18,9 +12,7 @@ from ..errors import ParameterError
 def fractal_amplitude(k_l, k_s, hurst, m2):
     """PSD amplitude C of (2.18) with k_r = k_l from a prescribed m2^h, eq. (7.1).
 
-    ``C = 4 (1 - H) m2 / ((2 pi)^3 (k_s^(2-2H) - k_l^(2-2H)))`` [length^(4-2H)] with ``k_l``,
-    ``k_s`` in cycles/length and ``m2`` dimensionless. The one source of C: the models call it
-    ``psd_amplitude`` (:mod:`roughpetsc.models.persson`).
+    C [length^(4-2H)] with ``k_l``, ``k_s`` in cycles/length; the models call it ``psd_amplitude``.
     """
     return 4.0 * (1.0 - hurst) * m2 / ((2.0 * np.pi) ** 3 * (k_s ** (2 - 2 * hurst) - k_l ** (2 - 2 * hurst)))
 
@@ -56,23 +48,10 @@ DEFAULT_GENERATOR = "filter"  # the command line's embedded surface and files wr
 def fractal(grid, k_l, k_s, hurst, m2, seed, generator=DEFAULT_GENERATOR):
     """Gaussian isotropic self-affine surface of section 7.1, with the PSD (2.18) (k_r = k_l, C from (7.1)).
 
-    White Gaussian noise (unit variance, one sample per node, drawn from
-    ``numpy.random.default_rng(seed)``) is transformed and shaped in Fourier space:
-
-    * ``generator="filter"``: multiplied by ``sqrt(S(k) n0 n1 / A0)``, so that the *expected* discrete
-      spectrum is the PSD; the amplitude of each mode is random, as the noise's.
-    * ``generator="xu"``: (7.2)-(7.5) of the dissertation (Xu and Jackson's algorithm): divided by the
-      noise's own spectrum (its modulus, ``S[h0]`` of (7.4)) and multiplied by the same factor, so that
-      every realisation carries the prescribed amplitude ``sqrt(S(k))`` exactly and only the phase (that
-      of the noise, uniform and Hermitian-symmetric; the random phase theta of (7.5) is absorbed in it)
-      is random. Spectral moments are then the same for every seed.
-
-    The Hermitian symmetry (7.5) holds because the noise is real. The result is the same array on every
-    MPI rank: each rank computes the whole surface and keeps its rows.
-
-    Returns
-    -------
-    ndarray, shape (n0, n1): heights with zero mean, length units.
+    White Gaussian noise from ``numpy.random.default_rng(seed)`` is shaped in Fourier space. ``generator="filter"``:
+    multiplied by ``sqrt(S(k) n0 n1 / A0)``, so the *expected* spectrum is the PSD; ``"xu"``: (7.2)-(7.5) (Xu and
+    Jackson), divided by the noise's modulus first, so every realisation carries ``sqrt(S(k))`` exactly and only
+    the phase is random. Heights [length], zero mean, the same array on every rank.
     """
     check_fractal_parameters(grid, k_l, k_s, hurst, m2)
     if generator not in GENERATORS:
@@ -103,11 +82,7 @@ def check_waviness(amplitude, *wavelengths):
 
 
 def check_divides(cell, wavelength):
-    """Raise :class:`ParameterError` unless ``wavelength`` divides the periodic cell's side ``cell`` (length units).
-
-    A wave that does not fit a whole number of times into the cell is cut at the cell's edge, and the
-    periodic cell repeats that cut: another surface than the one asked for.
-    """
+    """Raise :class:`ParameterError` unless ``wavelength`` divides the cell's side ``cell`` (else the cell cuts it)."""
     count = cell / wavelength
     if not (round(count) >= 1 and abs(count - round(count)) <= 1e-9 * count):
         raise ParameterError("wavelength", f"the wavelength {wavelength:g} does not divide the cell side {cell:g} "
@@ -116,10 +91,7 @@ def check_divides(cell, wavelength):
 
 
 def bisinusoid(grid, amplitude, wavelength0, wavelength1):
-    """Bisinusoidal waviness (3.52): Delta cos(2 pi y / lambda_y) cos(2 pi x / lambda_x), length units.
-
-    Each wavelength must divide its side of the cell (:func:`check_divides`).
-    """
+    """Bisinusoidal waviness (3.52): Delta cos(2 pi y / lambda_y) cos(2 pi x / lambda_x) [length]."""
     check_waviness(amplitude, wavelength0, wavelength1)
     check_divides(grid.l0, wavelength0)
     check_divides(grid.l1, wavelength1)
@@ -128,12 +100,9 @@ def bisinusoid(grid, amplitude, wavelength0, wavelength1):
 
 
 def wave(grid, amplitude, wavelength):
-    """One-dimensional wave along axis 1 (Westergaard's problem), zero mean.
+    """One-dimensional wave ``-h cos(2 pi x / lambda)`` along axis 1 (Westergaard's problem), h = ``amplitude``.
 
-    The profile ``2 h sin^2(pi x / lambda)`` less its mean ``h``, i.e.
-    ``-h cos(2 pi x / lambda)`` with ``h`` = ``amplitude``. Its complete-contact
-    pressure is ``p_star = pi E* h / lambda`` (Johnson, Contact Mechanics, 13.2). The wavelength must
-    divide the cell length (:func:`check_divides`).
+    Its complete-contact pressure is ``p_star = pi E* h / lambda`` (Johnson, Contact Mechanics, 13.2).
     """
     check_waviness(amplitude, wavelength)
     check_divides(grid.l1, wavelength)

@@ -9,11 +9,7 @@ from ..errors import ParameterError
 
 @dataclass(frozen=True)
 class Grid:
-    """A periodic cell of ``n0 x n1`` nodes and size ``l0 x l1`` (length units).
-
-    Raises :class:`ParameterError` naming ``n0``, ``n1``, ``l0`` or ``l1`` for a count of nodes that is
-    not a positive whole number or a side that is not positive and finite.
-    """
+    """A periodic cell of ``n0 x n1`` nodes (positive whole numbers) and size ``l0 x l1`` (positive, finite)."""
 
     n0: int
     n1: int
@@ -49,11 +45,7 @@ class Grid:
         return y, x
 
     def rfft_wavenumbers(self, rows=slice(None)):
-        """Wavenumbers (k0, k1) in cycles/length of the ``rfft2`` layout.
-
-        ``k0`` has shape ``(m, 1)`` for the selected rows of the full frequency
-        axis 0 and ``k1`` has shape ``(1, n1 // 2 + 1)``.
-        """
+        """Wavenumbers (k0, k1) [cycles/length] of the ``rfft2`` layout, shapes ``(rows, 1)``, ``(1, n1 // 2 + 1)``."""
         k0 = np.fft.fftfreq(self.n0, d=self.l0 / self.n0)[rows][:, None]
         k1 = np.fft.rfftfreq(self.n1, d=self.l1 / self.n1)[None, :]
         return k0, k1

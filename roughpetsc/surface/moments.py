@@ -1,33 +1,17 @@
 """The moments and bandwidths recorded for every surface a run solves (solve and ensemble modes).
 
-One function, so that a load path's file and an ensemble's file describe a surface by the same
-numbers: the spectral moments (2.12) of h (n = 0..6) and of the pressure surface p_c (2.47)
-(n = 0..4), each the mean of its x and y moments, and the bandwidths alpha^h (2.16) and alpha^p (2.54)
-from them; optionally also the bandwidths from the finite-difference moments (7.6)/(7.7), the
-dissertation's "Num" values of Table 7.7.
+One function, so that a load path's file and an ensemble's file describe a surface by the same numbers.
 """
 
 from . import spectra
 
 
 def surface_moments(grid, heights, E_star, finite_differences=False):
-    """Moments and bandwidths of one surface.
+    """Moments and bandwidths of one surface (E* (1.6) [pressure]), the isotropic means of x and y.
 
-    Parameters
-    ----------
-    grid : roughpetsc.surfaces.Grid
-    heights : ndarray, shape grid.shape [length]
-    E_star : float
-        Composite modulus E* (1.6) [pressure]; p_c and its moments scale with it.
-    finite_differences : bool
-        Also ``alpha_h_fd`` and ``alpha_p_fd``: (2.16)/(2.54) from the finite-difference moments
-        (7.6)/(7.7) with the dissertation's stencils.
-
-    Returns
-    -------
-    dict: ``m0h m2h m4h m6h`` [length^2 / length^n], ``m0p m2p m4p`` [pressure^2 / length^n],
-    ``alpha_h``, ``alpha_p`` (spectral, dimensionless), and with ``finite_differences``
-    ``alpha_h_fd``, ``alpha_p_fd``.
+    Returns ``m0h m2h m4h m6h`` [length^2 / length^n] (2.12), ``m0p m2p m4p`` [pressure^2 / length^n] of p_c
+    (2.47), ``alpha_h`` (2.16), ``alpha_p`` (2.54), and with ``finite_differences`` ``alpha_h_fd``, ``alpha_p_fd``
+    from the finite-difference moments (7.6)/(7.7) (the "Num" values of Table 7.7).
     """
     if finite_differences:
         summary = spectra.surface_moment_summary(grid, heights, E_star)

@@ -5,11 +5,9 @@ Realisation ``i`` of an ensemble with master seed ``S`` (``-ensemble_seed``) is 
 
     seed_i = SeedSequence(S, spawn_key=(i,)).generate_state(1, uint32)[0] & 0x7fffffff,
 
-the first word of ``numpy.random.SeedSequence(S).spawn(i + 1)[i]`` cut to 31 bits (so that
-``-mode solve -surface_seed seed_i`` rebuilds that one surface). ``-mode stats -stats_ensemble n``
-and ``-mode ensemble -ensemble_size n`` both use it (docs/conventions.md, "Seeds"): the surfaces of a
-stats ensemble are those of the BEM ensemble with the same master seed, on any number of ranks.
-Children of a SeedSequence are statistically independent streams, unlike consecutive seeds.
+the first word of ``numpy.random.SeedSequence(S).spawn(i + 1)[i]`` cut to 31 bits (so that ``-mode solve
+-surface_seed seed_i`` rebuilds it). ``-mode stats -stats_ensemble n`` and ``-mode ensemble -ensemble_size n`` both
+use it (docs/conventions.md, "Seeds"); children of a SeedSequence are independent streams, unlike consecutive seeds.
 """
 
 import numpy as np
@@ -20,19 +18,7 @@ RULE = ("seed_i = SeedSequence(ensemble_seed, spawn_key=(i,)).generate_state(1, 
 
 
 def surface_seed(master, index):
-    """The white-noise seed of realisation ``index`` of the ensemble with master seed ``master``.
-
-    Parameters
-    ----------
-    master : int
-        The master seed, >= 0.
-    index : int
-        The realisation, >= 0.
-
-    Returns
-    -------
-    int in [0, 2**31): the first word of ``SeedSequence(master).spawn(index + 1)[index]``, 31 bits.
-    """
+    """The white-noise seed in [0, 2**31) of realisation ``index`` >= 0 of the ensemble with master seed ``master``."""
     sequence = np.random.SeedSequence(master, spawn_key=(index,))
     return int(sequence.generate_state(1, np.uint32)[0] & SEED_BITS)
 

@@ -1,20 +1,11 @@
 """Spectral moments, bandwidth parameters and the pressure surface (the dissertation, ch. 2 and sec. 7.2).
 
-Conventions (docs/conventions.md): Fourier pair (2.1)/(2.2), wavenumbers ``k`` in
-cycles/length, angular wavenumbers ``w = 2 pi k`` only inside moments (2.12).
-Array layout as in :mod:`roughpetsc.surfaces`: axis 0 = rows = ``y``, axis 1 = ``x``.
-
-Moments of a field ``f`` (height ``h`` in length units, or the pressure
-surface ``p_c`` in pressure units) along one direction:
-
-* from the discrete spectrum (the discrete form of (2.12)/(2.13)):
-  ``m_n0 = (n0 n1)^-2 sum_k |DFT(f)_k|^2 (2 pi k_x)^n``, ``m_0n`` with ``k_y``;
-* by finite differences (7.6)/(7.7): ``m_n0 = < (d^(n/2) f / dx^(n/2))^2 >``.
-
-The dissertation's "Num" columns (Tables 7.2-7.6, 8.2, 8.3) are the finite-difference
-moments with the stencils of :data:`SEED_STENCILS` (see :func:`fd_derivative`);
-the moment of a direction-free quantity (the ``m_n`` of an isotropic surface)
-is the mean of the x and y moments (sec. 7.2.2).
+Conventions (docs/conventions.md): Fourier pair (2.1)/(2.2), wavenumbers ``k`` in cycles/length, angular
+wavenumbers ``2 pi k`` only inside moments (2.12); axis 0 = rows = ``y``, axis 1 = ``x``. Moments of a field
+``f`` (h [length] or p_c [pressure]) along one direction come from the discrete spectrum, (2.12)/(2.13), or from
+finite differences (7.6)/(7.7). The dissertation's "Num" columns (Tables 7.2-7.6, 8.2, 8.3) are the
+finite-difference moments with the stencils of :data:`SEED_STENCILS`; an isotropic surface's ``m_n`` is the mean
+of its x and y moments (sec. 7.2.2).
 """
 
 from math import prod
@@ -26,13 +17,8 @@ from ..errors import ParameterError
 MOMENT_ORDERS = (0, 2, 4, 6)
 AXES = {"x": 1, "y": 0}
 
-# Finite-difference schemes for the derivative of order 1, 2, 3 along one axis.
-# "seed" (the name the option -stats_fd_scheme has always taken): central first
-# derivative, three-point second derivative, and the third derivative as the
-# central difference of the three-point second derivative; this is the scheme
-# that reproduces the dissertation's tables.
-# "central": the central difference applied repeatedly (the literal reading of
-# "central differentiation of the derivative of order n - 1" in sec. 7.2.1).
+# "seed" reproduces the dissertation's tables; "central" is the literal reading of sec. 7.2.1
+# ("central differentiation of the derivative of order n - 1"). Stencils: :func:`fd_derivative`.
 SEED_STENCILS = "seed"
 FD_SCHEMES = ("seed", "central")
 
@@ -40,17 +26,9 @@ FD_SCHEMES = ("seed", "central")
 # --- Moments of a discrete field
 
 def rfft_multiplicity(n1):
-    """How often each column of an ``rfft2`` spectrum appears in the full spectrum.
+    """How often each ``rfft2`` column appears in the full spectrum, shape (1, n1 // 2 + 1).
 
-    Parameters
-    ----------
-    n1 : int
-        Number of nodes along axis 1.
-
-    Returns
-    -------
-    ndarray, shape (1, n1 // 2 + 1): 1 for the zero (and, for even ``n1``, the
-    Nyquist) column, 2 for the others (their Hermitian twins).
+    1 for the zero (and, for even ``n1``, the Nyquist) column, 2 for the others (their Hermitian twins).
     """
     weights = np.full((1, n1 // 2 + 1), 2.0)
     weights[0, 0] = 1.0
@@ -60,10 +38,7 @@ def rfft_multiplicity(n1):
 
 
 def power_spectrum(grid, field):
-    """Discrete power ``|DFT(f)_k|^2 / (n0 n1)^2`` in the ``rfft2`` layout, Hermitian weights included.
-
-    Summing it over all entries gives ``<f^2>`` (Parseval). Units: those of ``f`` squared.
-    """
+    """Discrete power ``|DFT(f)_k|^2 / (n0 n1)^2`` [f^2] in the ``rfft2`` layout, Hermitian weights included."""
     spectrum = np.fft.rfft2(field)
     power = spectrum.real ** 2 + spectrum.imag ** 2
     power *= rfft_multiplicity(grid.n1) / float(grid.size) ** 2
@@ -71,7 +46,7 @@ def power_spectrum(grid, field):
 
 
 def radial_bin_width(grid):
-    """The width of the annuli of :func:`radial_psd_sums`: the fundamental wavenumber 1 / max(l0, l1) [cycles/length]."""
+    """Annulus width of :func:`radial_psd_sums`: the fundamental wavenumber 1 / max(l0, l1) [cycles/length]."""
     return 1.0 / max(grid.l0, grid.l1)
 
 
@@ -106,10 +81,7 @@ def radial_psd_sums(grid, field):
 
 
 def radial_psd(grid, sums):
-    """The radially averaged PSD of :func:`radial_psd_sums` (summed over surfaces): ``(k, psd, modes)``.
-
-    ``k`` is the centre of each annulus (b dk) [cycles/length], ``psd`` the mean S over its modes.
-    """
+    """Radially averaged PSD ``(k, psd, modes)`` of :func:`radial_psd_sums`: annulus centres, mean S per mode."""
     k = radial_bin_width(grid) * np.arange(1, sums["modes"].size + 1)
     with np.errstate(invalid="ignore", divide="ignore"):
         return k, np.where(sums["modes"] > 0, sums["psd"] / sums["modes"], np.nan), sums["modes"]
@@ -118,13 +90,10 @@ def radial_psd(grid, sums):
 def fit_fractal_psd(grid, field, band):
     """Fit (2.18), ``S = C k^-2(1+H)``, to the PSD of the modes of a periodic field with ``|k|`` in ``band``.
 
-    H from the least-squares line ln S = ln C - 2 (1 + H) ln k over the modes (the log of a random
-    amplitude's power has a constant bias, which moves the line but not its slope), then C as the mean
-    of S k^2(1+H) over them (unbiased for random amplitudes). Both are exact for a PSD that is exactly
-    (2.18) in the band (``generator="xu"``). ``band = (k_min, k_max)`` in cycles/length.
-
-    Returns ``{"hurst", "C", "modes", "rms_log_residual"}`` (C in [field]^2 length^(4 - 2H)), or None
-    when fewer than two distinct |k| with power lie in the band.
+    H from the least-squares line ln S = ln C - 2 (1 + H) ln k (a log's bias moves the line, not its slope),
+    then C as the mean of S k^2(1+H) (unbiased). ``band = (k_min, k_max)`` [cycles/length]. Returns
+    ``{"hurst", "C", "modes", "rms_log_residual"}`` (C in [field]^2 length^(4 - 2H)), or None when fewer than
+    two distinct |k| with power lie in the band.
     """
     k, psd, multiplicity = mode_psd(grid, field)
     chosen = (k >= band[0] * (1 - 1e-12)) & (k <= band[1] * (1 + 1e-12)) & (psd > 0)
@@ -142,20 +111,8 @@ def fit_fractal_psd(grid, field, band):
 def spectral_moments(grid, field, orders=MOMENT_ORDERS):
     """Directional spectral moments ``m_n0`` (x) and ``m_0n`` (y) of a periodic field, eq. (2.12)/(2.13).
 
-    Sums over the discrete power spectrum (:func:`power_spectrum`).
-
-    Parameters
-    ----------
-    grid : roughpetsc.surfaces.Grid
-    field : ndarray, shape grid.shape
-        Heights [length] or pressures [pressure].
-    orders : sequence of even int
-
-    Returns
-    -------
-    dict ``{"x": {n: m_n0}, "y": {n: m_0n}}`` in [field]^2 / length^n. Exact
-    for any trigonometric polynomial resolved by the grid. The mean (``k = 0``) is excluded, so ``m_0``
-    is the variance.
+    Returns ``{"x": {n: m_n0}, "y": {n: m_0n}}`` in [field]^2 / length^n, from :func:`power_spectrum`
+    without the k = 0 mode (``m_0`` is the variance).
     """
     k0, k1 = grid.rfft_wavenumbers()
     power = power_spectrum(grid, field).copy()  # C order (rfft2's is not): the order of the sums below
@@ -169,26 +126,10 @@ def spectral_moments(grid, field, orders=MOMENT_ORDERS):
 
 
 def fd_derivative(field, spacing, axis, order, scheme=SEED_STENCILS):
-    """Periodic finite-difference derivative of order 1, 2 or 3 along one axis.
+    """Periodic finite-difference derivative of order 1, 2 or 3 along ``axis`` (node spacing Delta [length]).
 
-    Parameters
-    ----------
-    field : ndarray
-    spacing : float
-        Node spacing Delta along ``axis`` [length].
-    axis : int
-        0 (y, rows) or 1 (x).
-    order : int
-        1, 2 or 3.
-    scheme : {"seed", "central"}
-        ``"seed"``: ``(f[i+1] - f[i-1]) / (2 Delta)``, ``(f[i+1] - 2 f[i] + f[i-1]) / Delta^2``
-        and the central difference of the latter for order 3 (symbols
-        ``i sin(w Delta)/Delta``, ``-(2 sin(w Delta/2)/Delta)^2`` and their product);
-        ``"central"``: the central first difference applied ``order`` times.
-
-    Returns
-    -------
-    ndarray, same shape: [field] / length^order.
+    ``scheme="seed"``: ``(f[i+1] - f[i-1]) / (2 Delta)``, ``(f[i+1] - 2 f[i] + f[i-1]) / Delta^2`` and the
+    central difference of the latter for order 3; ``"central"``: the central difference ``order`` times.
     """
     if scheme not in FD_SCHEMES:
         raise ParameterError("scheme", f"unknown finite-difference scheme {scheme!r}; use one of {FD_SCHEMES}")
@@ -214,21 +155,9 @@ def fd_derivative(field, spacing, axis, order, scheme=SEED_STENCILS):
 
 
 def fd_moments(grid, field, orders=MOMENT_ORDERS, scheme=SEED_STENCILS):
-    """Directional moments by finite differences, eqs. (7.6) (x) and (7.7) (y).
+    """Directional moments by finite differences, eqs. (7.6) (x) and (7.7) (y), as :func:`spectral_moments`.
 
-    ``m_n0 = < (d^(n/2) f / dx^(n/2))^2 >`` over all nodes of the periodic
-    grid; ``m_0 = <(f - <f>)^2>``.
-
-    Parameters
-    ----------
-    grid : roughpetsc.surfaces.Grid
-    field : ndarray, shape grid.shape
-    orders : sequence of even int in (0, 2, 4, 6)
-    scheme : {"seed", "central"}, see :func:`fd_derivative`.
-
-    Returns
-    -------
-    dict ``{"x": {n: m_n0}, "y": {n: m_0n}}`` in [field]^2 / length^n.
+    ``m_n0 = < (d^(n/2) f / dx^(n/2))^2 >`` over the nodes (:func:`fd_derivative`); ``m_0 = <(f - <f>)^2>``.
     """
     spacing = {"x": grid.l1 / grid.n1, "y": grid.l0 / grid.n0}
     variance = float(np.mean((field - field.mean()) ** 2))
@@ -245,11 +174,9 @@ def fd_moments(grid, field, orders=MOMENT_ORDERS, scheme=SEED_STENCILS):
 
 
 def fd_symbol_squared(k, spacing, order, scheme=SEED_STENCILS):
-    """``|symbol|^2`` of :func:`fd_derivative` at wavenumber ``k`` [cycles/length].
+    """``|symbol|^2`` of :func:`fd_derivative` at ``k`` [cycles/length], in 1 / length^(2 order).
 
-    The expected finite-difference moment of a field with discrete power
-    ``P_k`` is ``sum_k P_k |symbol(k)|^2``; for ``Delta -> 0`` the symbol tends to
-    ``(2 pi k)^order``. Units: 1 / length^(2 order).
+    The expected finite-difference moment of a field with discrete power ``P_k`` is ``sum_k P_k |symbol(k)|^2``.
     """
     theta = 2.0 * np.pi * np.asarray(k, dtype=float) * spacing
     central = (np.sin(theta) / spacing) ** 2
@@ -287,23 +214,10 @@ def isotropy_factor(n):
 
 
 def fractal_height_moment(n, k_l, k_s, hurst, amplitude, k_r=None):
-    """Moment m_n^h of the PSD (2.18), eq. (2.19); eq. (2.20) when ``k_r = k_l`` (default).
+    """Moment m_n^h [length^(2 - n)] of the PSD (2.18), eq. (2.19); (2.20) when ``k_r = k_l`` (default).
 
-    Parameters
-    ----------
-    n : even int
-    k_l, k_s : float
-        Cut-off wavenumbers [cycles/length].
-    hurst : float
-        H in (0, 1).
-    amplitude : float
-        C of (2.18) [length^(2 - 2H)], so that S^h has units length^4.
-    k_r : float, optional
-        Roll-off wavenumber, ``k_l <= k_r <= k_s``.
-
-    Returns
-    -------
-    float: m_n^h [length^(2 - n)]. n = 0, 2, 4, 6 give (2.21)-(2.24).
+    Cut-offs ``k_l <= k_r <= k_s`` [cycles/length], ``amplitude`` C of (2.18) [length^(2 - 2H)].
+    n = 0, 2, 4, 6 give (2.21)-(2.24).
     """
     k_r = k_l if k_r is None else k_r
     plateau = k_r ** (-2.0 * (1.0 + hurst)) / (n + 2) * (k_r ** (n + 2) - k_l ** (n + 2))
@@ -348,10 +262,7 @@ def pressure_moment_from_heights(n, height_moments, e_star=1.0):
 def fractal_closed_forms(k_l, k_s, hurst, amplitude, e_star=1.0):
     """All closed forms of a fractal group: m_n^h (2.21-2.24), alpha^h (2.25), m_n^p (2.56-2.58), alpha^p (2.59).
 
-    Returns
-    -------
-    dict with keys ``"h"`` ({0, 2, 4, 6: m_n^h}), ``"p"`` ({0, 2, 4: m_n^p}),
-    ``"alpha_h"`` and ``"alpha_p"``.
+    Returns ``{"h": {0, 2, 4, 6: m_n^h}, "p": {0, 2, 4: m_n^p}, "alpha_h", "alpha_p"}``.
     """
     return {
         "h": {n: fractal_height_moment(n, k_l, k_s, hurst, amplitude) for n in MOMENT_ORDERS},
@@ -364,20 +275,10 @@ def fractal_closed_forms(k_l, k_s, hurst, amplitude, e_star=1.0):
 # --- Pressure surface
 
 def pressure_surface(grid, heights, e_star=1.0):
-    """Complete-contact pressure p_c = F^-1[pi E* k F[h]], eq. (2.47).
+    """Complete-contact pressure p_c = F^-1[pi E* k F[h]] [pressure], zero mean, eq. (2.47); E* (1.6).
 
-    Parameters
-    ----------
-    grid : roughpetsc.surfaces.Grid
-    heights : ndarray, shape grid.shape [length]
-    e_star : float
-        Composite modulus E* (1.6) [pressure].
-
-    Returns
-    -------
-    ndarray, shape grid.shape: p_c [pressure], zero mean. The "pressure surface"
-    of the dissertation is ``-p_c``. The solver applies the same symbol
-    distributed over the ranks (:meth:`roughpetsc.westergaard.Westergaard.pressure_surface`).
+    The dissertation's "pressure surface" is ``-p_c``; the solver applies the same symbol over the ranks
+    (:meth:`roughpetsc.westergaard.Westergaard.pressure_surface`).
     """
     return np.fft.irfft2(np.fft.rfft2(heights) * complete_contact_symbol(grid, e_star), s=grid.shape)
 
@@ -389,22 +290,10 @@ def complete_contact_symbol(grid, e_star):
 
 
 def heights_from_pressure_surface(grid, complete_contact_pressure, e_star=1.0):
-    """Zero-mean heights whose complete-contact pressure is the given field: the inverse of :func:`pressure_surface`.
+    """Zero-mean heights [length] whose complete-contact pressure is the given field (:func:`pressure_surface`).
 
-    h = F^-1[F[p_c] / (pi E* k)] with the k = 0 mode dropped, so that ``pressure_surface(grid, h, e_star)``
-    returns ``p_c - mean(p_c)`` to round-off. Used to build a problem whose nearly complete contact has a
-    prescribed traction on its non-contact regions (the cracks of the dissertation's chapters 5-6).
-
-    Parameters
-    ----------
-    grid : roughpetsc.surfaces.Grid
-    complete_contact_pressure : ndarray, shape grid.shape [pressure]
-    e_star : float
-        Composite modulus E* (1.6) [pressure].
-
-    Returns
-    -------
-    ndarray, shape grid.shape [length]
+    h = F^-1[F[p_c] / (pi E* k)] without the k = 0 mode, so ``pressure_surface(grid, h, e_star)`` returns
+    ``p_c - mean(p_c)``: a nearly complete contact with a prescribed traction on its cracks (chapters 5-6).
     """
     symbol = complete_contact_symbol(grid, e_star)
     symbol[0, 0] = 1.0
@@ -418,16 +307,10 @@ def heights_from_pressure_surface(grid, complete_contact_pressure, e_star=1.0):
 def surface_moment_summary(grid, heights, e_star=1.0, scheme=SEED_STENCILS):
     """Moments and bandwidths of a surface and of its pressure surface.
 
-    Returns
-    -------
-    dict with
-    ``"h_fd"``, ``"h_spectral"``: directional moments of h, n = 0, 2, 4, 6
-    (finite differences (7.6)/(7.7) and spectrum (2.12));
-    ``"p_fd"``, ``"p_spectral"``: the same for p_c (2.47), n = 0, 2, 4;
-    ``"alpha_h"``, ``"alpha_p"``: (2.16)/(2.54) from the isotropic means of the
-    finite-difference moments (the dissertation's "Num");
-    ``"alpha_h_spectral"``, ``"alpha_p_spectral"``: the same from the spectrum;
-    ``"alpha_p_from_h"``: 27/20 m2 m6 / m4^2 (2.54) with the spectral m^h.
+    Returns a dict: ``"h_fd"``, ``"h_spectral"``: directional moments of h, n = 0..6 ((7.6)/(7.7) and (2.12));
+    ``"p_fd"``, ``"p_spectral"``: the same for p_c (2.47), n = 0..4; ``"alpha_h"``, ``"alpha_p"``: (2.16)/(2.54)
+    from the finite-difference moments ("Num"); ``"alpha_h_spectral"``, ``"alpha_p_spectral"``: from the
+    spectrum; ``"alpha_p_from_h"``: 27/20 m2 m6 / m4^2 (2.54) with the spectral m^h.
     """
     pressure = pressure_surface(grid, heights, e_star)
     summary = {

@@ -1,13 +1,8 @@
 """Asperities (summits) of a surface and their probability densities (the dissertation, sec. 2.4-2.6, 7.2.2).
 
-A summit is a node strictly higher than its eight nearest neighbours on the
-periodic grid (sec. 7.2.2). At a summit the second derivatives are taken by
-finite differences (three-point stencils for ``f_xx`` and ``f_yy``, the
-four-point central stencil for ``f_xy``), which give the absolute mean
-curvature (2.31) and the geometric curvature (2.32). The same routines serve the
-rough surface ``h`` and the pressure surface ``-p_c`` (sec. 2.6).
-
-Dimensionless variables (2.34)/(2.36): ``xi* = xi / sqrt(m0)``,
+A summit is a node strictly higher than its eight periodic neighbours (sec. 7.2.2); finite-difference second
+derivatives there give the mean curvature (2.31) and the geometric curvature (2.32). The same routines serve ``h``
+and the pressure surface ``-p_c`` (sec. 2.6). Dimensionless variables (2.34)/(2.36): ``xi* = xi / sqrt(m0)``,
 ``kappa* = kappa / sqrt(m4)``, with the moments of the same field.
 """
 
@@ -16,28 +11,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import erf, erfc, erfcx
 
-# Eight neighbours (row offset, column offset).
 NEIGHBOUR_OFFSETS = tuple((di, dj) for di in (-1, 0, 1) for dj in (-1, 0, 1) if (di, dj) != (0, 0))
 
 
 @dataclass(frozen=True)
 class Summits:
-    """Summits of one field.
-
-    Attributes
-    ----------
-    rows, cols : ndarray of int
-        Node indices of the summits.
-    height : ndarray
-        Summit height xi [field units], measured from the mean plane.
-    mean_curvature : ndarray
-        kappa_m = -(f_xx + f_yy) / 2, eq. (2.31) [field / length^2].
-    hessian_determinant : ndarray
-        f_xx f_yy - f_xy^2 [field^2 / length^4]; negative at summits of the
-        eight-neighbour test whose discrete Hessian is not definite.
-    area : float
-        Area of the cell [length^2].
-    """
+    """Summits of one field: node indices, height xi above the mean plane [field], kappa_m = -(f_xx + f_yy) / 2
+    (2.31) [field / length^2], f_xx f_yy - f_xy^2 [field^2 / length^4] (negative where the discrete Hessian is not
+    definite) and the cell's area [length^2]."""
 
     rows: np.ndarray
     cols: np.ndarray
@@ -71,12 +52,8 @@ def summit_mask(field):
 
 
 def hessian_at(grid, field, rows, cols):
-    """Finite-difference second derivatives ``(f_xx, f_yy, f_xy)`` at the given nodes (periodic).
-
-    ``f_xx = (f[i, j+1] - 2 f[i, j] + f[i, j-1]) / dx^2``, likewise ``f_yy`` along
-    rows, ``f_xy = (f[i+1, j+1] - f[i+1, j-1] - f[i-1, j+1] + f[i-1, j-1]) / (4 dx dy)``.
-    Units: field / length^2.
-    """
+    """Second derivatives ``(f_xx, f_yy, f_xy)`` [field / length^2] at the given nodes: three-point stencils for
+    ``f_xx``, ``f_yy`` and the four-point central stencil for ``f_xy`` (periodic)."""
     dx = grid.l1 / grid.n1
     dy = grid.l0 / grid.n0
 
@@ -91,18 +68,7 @@ def hessian_at(grid, field, rows, cols):
 
 
 def find_summits(grid, field):
-    """Summits of ``field`` by eight nearest neighbours with their heights and curvatures.
-
-    Parameters
-    ----------
-    grid : roughpetsc.surfaces.Grid
-    field : ndarray, shape grid.shape
-        ``h`` [length] for the rough surface, ``-p_c`` [pressure] for the pressure surface.
-
-    Returns
-    -------
-    Summits
-    """
+    """:class:`Summits` of ``field`` (``h`` [length] or ``-p_c`` [pressure]) by eight nearest neighbours."""
     rows, cols = np.nonzero(summit_mask(field))
     f_xx, f_yy, f_xy = hessian_at(grid, field, rows, cols)
     return Summits(rows=rows, cols=cols, height=field[rows, cols] - field.mean(),
@@ -113,19 +79,7 @@ def find_summits(grid, field):
 # --- Closed-form densities of an isotropic Gaussian surface
 
 def summit_height_pdf(xi, alpha):
-    """PDF of the dimensionless summit height xi* = xi / sqrt(m0), eq. (2.42) (Nayak; Greenwood, App. A).
-
-    Parameters
-    ----------
-    xi : array_like
-        xi* (dimensionless).
-    alpha : float
-        Bandwidth parameter (2.16), > 1.5.
-
-    Returns
-    -------
-    ndarray: probability density (integrates to 1 over the real line).
-    """
+    """PDF of the summit height xi* = xi / sqrt(m0), eq. (2.42) (Nayak; Greenwood, App. A); alpha (2.16) > 1.5."""
     xi = np.asarray(xi, dtype=float)
     c1 = alpha / (2.0 * alpha - 3.0)
     beta = xi * np.sqrt(3.0 / (2.0 * (2.0 * alpha - 3.0)))
@@ -166,11 +120,9 @@ def summit_height_geometric_curvature_pdf(xi, kappa_g, alpha):
 
 
 def summit_geometric_curvature_pdf(kappa_g):
-    """Marginal PDF of kappa_g* = kappa_g / sqrt(m4): (2.41) integrated over xi*.
+    """Marginal PDF of kappa_g* = kappa_g / sqrt(m4): (2.41) integrated over xi*, for any alpha.
 
-    The xi-integral of (2.41) is a Gaussian average of erfc, which gives
-    ``(9/2) k^3 exp(3 k^2 / 2) erfc(3 k / 2)`` for any alpha (checked against
-    quadrature of (2.41) in the tests). Zero for ``kappa_g* < 0``.
+    ``(9/2) k^3 exp(3 k^2 / 2) erfc(3 k / 2)``; zero for ``kappa_g* < 0``.
     """
     kappa = np.maximum(np.asarray(kappa_g, dtype=float), 0.0)
     pdf = 4.5 * kappa ** 3 * erfcx(1.5 * kappa) * np.exp(-0.75 * kappa ** 2)
@@ -186,17 +138,8 @@ def gaussian_pdf(z):
 def mccool_gw_inputs(m0, m2, m4):
     """Inputs of the Greenwood-Williamson model from the moments, McCool's relations (2.43)-(2.46).
 
-    Parameters
-    ----------
-    m0, m2, m4 : float
-        Moments of an isotropic Gaussian surface [length^2], [-], [length^-2]
-        (or the pressure-surface moments with pressure units).
-
-    Returns
-    -------
-    dict: ``eta`` summit density [1/length^2] (2.43), ``mean_summit_height`` m^h
-    [length] (2.44), ``radius`` R^h [length] (2.45), ``summit_height_rms``
-    sigma_s^h [length] (2.46), and ``alpha`` (2.16).
+    Returns ``eta`` [1/length^2] (2.43), ``mean_summit_height`` [length] (2.44), ``radius`` R^h [length] (2.45),
+    ``summit_height_rms`` [length] (2.46) and ``alpha`` (2.16).
     """
     alpha = m0 * m4 / m2 ** 2
     return {
@@ -209,12 +152,7 @@ def mccool_gw_inputs(m0, m2, m4):
 
 
 def measured_gw_inputs(summits):
-    """The measured counterparts of :func:`mccool_gw_inputs` for one set of summits.
-
-    ``eta`` = summits per area, ``mean_summit_height`` = mean xi,
-    ``radius`` = 1 / mean kappa_m (McCool's R^h is the reciprocal of the mean
-    summit mean curvature), ``summit_height_rms`` = standard deviation of xi.
-    """
+    """The measured counterparts of :func:`mccool_gw_inputs` (``radius`` = 1 / mean kappa_m, as McCool's R^h)."""
     return {
         "eta": summits.density,
         "mean_summit_height": float(np.mean(summits.height)),
@@ -226,12 +164,7 @@ def measured_gw_inputs(summits):
 # --- Measured densities and their distance to a closed form
 
 def binned_counts(values, edges):
-    """Counts of ``values`` in the bins of ``edges`` and the total number of finite values.
-
-    Returns
-    -------
-    (counts, total) : ndarray of int, int. ``total - counts.sum()`` values lie outside.
-    """
+    """``(counts, total)``: counts of ``values`` in the bins of ``edges`` and the number of finite values."""
     values = np.asarray(values, dtype=float)
     values = values[np.isfinite(values)]
     counts, _ = np.histogram(values, bins=edges)
@@ -239,11 +172,7 @@ def binned_counts(values, edges):
 
 
 def density_from_counts(counts, total, edges):
-    """Counts normalised as a density over the whole sample [1 / unit of values].
-
-    Values outside ``edges`` count in ``total``, so the densities integrate to
-    the fraction of the sample inside the range.
-    """
+    """Counts normalised as a density over the whole sample ``total`` [1 / unit of values]."""
     return np.asarray(counts) / (max(total, 1) * np.diff(edges))
 
 
@@ -262,17 +191,10 @@ def bin_probabilities(pdf, edges, points=8):
 
 
 def l1_distance_from_counts(counts, total, edges, pdf):
-    """L1 distance between binned counts and the closed-form ``pdf`` (twice the total variation).
+    """``(distance, noise)``: L1 distance between binned counts and ``pdf`` (twice the total variation).
 
-    ``sum_b |n_b / n - P_b| + |n_out / n - P_out|`` with ``P_b`` the probability of
-    bin ``b`` under ``pdf`` and "out" everything outside ``edges``. 0 = identical
-    binned distributions, 2 = disjoint.
-
-    Returns
-    -------
-    (distance, noise) : the distance and its expectation for an exact sample of
-    the same size drawn from ``pdf`` (multinomial, ``sum sqrt(2 P (1 - P) / (pi n))``),
-    which is the floor set by sampling alone for independent samples.
+    ``sum_b |n_b / n - P_b| + |n_out / n - P_out|``, "out" outside ``edges``; ``noise`` is its expectation for a
+    sample of ``pdf`` of the same size, ``sum sqrt(2 P (1 - P) / (pi n))``: the floor set by sampling alone.
     """
     measured = np.append(counts, total - np.sum(counts)) / total
     expected = bin_probabilities(pdf, edges)
