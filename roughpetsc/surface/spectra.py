@@ -118,11 +118,8 @@ def spectral_moments(grid, field, orders=MOMENT_ORDERS):
     power = power_spectrum(grid, field).copy()  # C order (rfft2's is not): the order of the sums below
     power[0, 0] = 0.0
     angular = {"x": 2.0 * np.pi * k1, "y": 2.0 * np.pi * k0}
-    moments = {}
-    for direction, w in angular.items():
-        w2 = w ** 2
-        moments[direction] = {n: float(np.sum(power * w2 ** (n // 2))) for n in orders}
-    return moments
+    return {direction: {n: float(np.sum(power * (w ** 2) ** (n // 2))) for n in orders}
+            for direction, w in angular.items()}
 
 
 def fd_derivative(field, spacing, axis, order, scheme=SEED_STENCILS):
@@ -161,16 +158,9 @@ def fd_moments(grid, field, orders=MOMENT_ORDERS, scheme=SEED_STENCILS):
     """
     spacing = {"x": grid.l1 / grid.n1, "y": grid.l0 / grid.n0}
     variance = float(np.mean((field - field.mean()) ** 2))
-    moments = {}
-    for direction, axis in AXES.items():
-        moments[direction] = {}
-        for n in orders:
-            if n == 0:
-                moments[direction][n] = variance
-                continue
-            derivative = fd_derivative(field, spacing[direction], axis, n // 2, scheme)
-            moments[direction][n] = float(np.mean(derivative ** 2))
-    return moments
+    return {direction: {n: float(np.mean(fd_derivative(field, spacing[direction], axis, n // 2, scheme) ** 2))
+                        if n else variance for n in orders}
+            for direction, axis in AXES.items()}
 
 
 def fd_symbol_squared(k, spacing, order, scheme=SEED_STENCILS):
