@@ -32,10 +32,7 @@ def nonadhesive_area(p):
 
 
 def nonadhesive_volume(p):
-    """V* = (8 sqrt 6 / 45) pi p*^(5/2): (5.28) in the groups (6.4)-(6.5).
-
-    (The printed (6.10), 16 sqrt3/45 pi p*^(5/2), is larger by sqrt 2 and
-    disagrees with (5.28) and with (6.21) at sigma0* = 0.)"""
+    """V* = (8 sqrt 6 / 45) pi p*^(5/2): (5.28) in the groups (6.4)-(6.5) (the printed (6.10) is sqrt 2 larger)."""
     return 8.0 * np.sqrt(6.0) / 45.0 * np.pi * np.maximum(np.asarray(p, float), 0.0) ** 2.5
 
 
@@ -52,9 +49,8 @@ def jkr_pmin():
 
 
 def jkr_radius(p, branch="stable"):
-    """Crack radius b* of the JKR limit at p* (roots of 3/2 t^5 - p t + sqrt 2 = 0,
-    t = sqrt b*).  ``branch="stable"`` gives the larger root (6.17), "unstable"
-    the smaller; NaN below p*_min."""
+    """Crack radius b* of the JKR limit at p*: the larger root (6.17) of (6.14) for ``branch="stable"``, else the
+    smaller; NaN below p*_min."""
     p = np.atleast_1d(np.asarray(p, float))
     bmin = (np.sqrt(2.0) / 6.0) ** 0.4           # argmin of (6.14)
     out = np.full(p.shape, np.nan)
@@ -84,14 +80,8 @@ def jkr_volume(b, p):
 class JKRCrack:
     """Penny-shaped adhesive crack in the JKR limit, Eqs. (6.11)-(6.21), with its load history.
 
-    The limit sigma0* -> inf of :class:`AdhesiveCrack` at a fixed w (docs/models.md): the same
-    interface (``points``, ``breakpoints``, ``state``, ``area``, ``volume``), with m = c / b = 1 (no
-    cohesive zone) and ``sigma = inf``.
-
-    Attributes
-    ----------
-    points : dict
-        ``{"B": (p*_min, b*_min, 1)}``: the snap-in point (6.15), the only finite turning point.
+    The limit sigma0* -> inf of :class:`AdhesiveCrack` at a fixed w (docs/models.md), with its interface, m = 1
+    and ``sigma = inf``; ``points`` holds only B, the snap-in point (6.15).
     """
 
     sigma = np.inf
@@ -101,15 +91,14 @@ class JKRCrack:
         self.points = {"B": (float(jkr_pmin()), float(b_min), 1.0)}
 
     def breakpoints(self):
-        """The p* at which the state of a crack changes with its history: B only."""
+        """The p* at which a crack's state changes with its history: B only."""
         return [self.points["B"][0]]
 
     def stable(self, p):
         """b* on the stable branch (6.17) of (6.14) at p* >= p*_min (NaN below).
 
-        The larger root t of 3/2 t^5 - p t + sqrt 2 = 0 (t = sqrt b*, the footnote to (6.14)) by Newton's
-        method from t = (2 p / 3)^(1/4), where the polynomial is sqrt 2 > 0: it is convex for t > 0, so
-        the iterates decrease monotonically to the root (linearly only at p*_min, the double root).
+        The larger root of 3/2 t^5 - p t + sqrt 2 = 0 (t = sqrt b*) by Newton's method from t = (2 p / 3)^(1/4):
+        the polynomial is convex there, so the iterates decrease monotonically to the root.
         """
         p = np.atleast_1d(np.asarray(p, float))
         ok = p >= self.points["B"][0]
@@ -125,11 +114,8 @@ class JKRCrack:
         return np.where(ok, t * t, np.nan)
 
     def state(self, p, p_min=None):
-        """Crack radius and m (= 1) after a load history; same conventions as :meth:`AdhesiveCrack.state`.
-
-        Loading (p* decreasing): the stable branch down to B, then closed. A crack that closed (history
-        minimum below p*_B) stays closed: its reopening point E (6.38) is at infinity.
-        """
+        """Crack radius and m (= 1) after a load history, as :meth:`AdhesiveCrack.state`; a crack that closed
+        (below p*_B) stays closed, its reopening point E (6.38) is at infinity."""
         p = np.atleast_1d(np.asarray(p, float))
         pm = p if p_min is None else np.minimum(np.atleast_1d(np.asarray(p_min, float)), p)
         b = np.where(pm >= self.points["B"][0], self.stable(np.maximum(p, self.points["B"][0])), 0.0)
@@ -146,13 +132,8 @@ class JKRCrack:
 
 # ------------------------------------------------------------ Maugis-Dugdale
 class AdhesiveCrack:
-    """Maugis-Dugdale penny-shaped adhesive crack for one sigma0* (6.22)-(6.39).
-
-    Attributes
-    ----------
-    points : dict
-        ``{"B", "C", "E", "F", "G"}`` -> (p*, b*, m) of Figs. 6.2-6.3.
-    """
+    """Maugis-Dugdale penny-shaped adhesive crack for one sigma0* (6.22)-(6.39); ``points``: B, C, E, F, G ->
+    (p*, b*, m) of Figs. 6.2-6.3."""
 
     Q_MAX = 60.0          # m = 1 - exp(-q), q in [0, Q_MAX]
 
@@ -210,10 +191,8 @@ class AdhesiveCrack:
         return 1.5 * self.b_of_q(q) ** 2 + self.sigma * np.sqrt(1.0 - m * m)
 
     def _stable_q(self, p):
-        """q on the stable branch (q >= qB) with p*(q) = p, to round-off.
-
-        The bracket comes from a table of p*(q) on the branch (increasing there), clustered at B; then
-        regula falsi with the Illinois modification (superlinear, and safe at B where the slope vanishes)."""
+        """q on the stable branch (q >= qB) with p*(q) = p: a bracket from the table of p*(q), then the Illinois
+        regula falsi (safe at B, where the slope vanishes)."""
         q_table, p_table = self._table
         i = np.clip(np.searchsorted(p_table, p), 1, q_table.size - 1)
         lo, hi = q_table[i - 1], q_table[i]
@@ -236,17 +215,13 @@ class AdhesiveCrack:
         return q
 
     def curve(self, n=2001, q_max=12.0):
-        """The Maugis-Dugdale solution curve (p*, b*, m) from F (m = 0) towards A,
-        m = 1 - exp(-q) for q in [0, q_max]."""
+        """The Maugis-Dugdale solution curve (p*, b*, m) from F (m = 0) towards A, q in [0, q_max]."""
         q = np.linspace(0.0, q_max, n)
         return self.p_of_q(q), self.b_of_q(q), self.m_of_q(q)
 
     def solution_set(self, n=4001, q_max=12.0):
-        """Every equilibrium state, as arrays (p*, b*, m, V*): the full-adhesion branch (6.36) from E
-        (p* = sigma0*, (6.38)) to F, then the Maugis-Dugdale curve (:meth:`curve`) from F towards A.
-
-        The set a path under volume (mean-gap) control visits; ``n // 4`` states on the first branch,
-        ``n`` on the second."""
+        """Every equilibrium state (p*, b*, m, V*): the full-adhesion branch (6.36) from E (6.38) to F (``n // 4``
+        states), then :meth:`curve` from F towards A (``n``)."""
         p_full = np.linspace(self.sigma, self.points["F"][0], n // 4)
         p_md, b_md, m_md = self.curve(n, q_max)
         p = np.concatenate([p_full, p_md])
@@ -263,22 +238,10 @@ class AdhesiveCrack:
         return np.where(ok, self.b_of_q(q), np.nan), np.where(ok, self.m_of_q(q), np.nan)
 
     def state(self, p, p_min=None):
-        """Crack radius and m after a load history (Figs. 6.2-6.3).
+        """Crack radius and m ``(b, m)`` at p* after a load history whose smallest p* was ``p_min`` (Figs. 6.2-6.3).
 
-        Parameters
-        ----------
-        p : array_like
-            Current p*.
-        p_min : array_like, optional
-            Smallest p* reached so far (default: ``p``, i.e. loading).  Loading
-            (p* decreasing): stable branch down to B, then closure (p_B <= sigma0*)
-            or the full-adhesion branch (6.36) down to E.  Unloading after
-            ``p_min < p_B``: closed below E (6.38), full adhesion from E to F
-            (6.39), jump to G and the stable branch beyond.
-
-        Returns
-        -------
-        b, m : ndarray
+        Loading: stable branch down to B, then closure (p_B <= sigma0*) or the full-adhesion branch (6.36) down
+        to E. Unloading after ``p_min < p_B``: closed below E (6.38), full adhesion from E to F (6.39), jump to G.
         """
         p = np.atleast_1d(np.asarray(p, float))
         pm = p if p_min is None else np.minimum(np.atleast_1d(np.asarray(p_min, float)), p)
@@ -322,24 +285,10 @@ CRACK_LAWS = ("maugis-dugdale", "jkr")
 class AdhesiveGW:
     """Adhesive adapted GW model of nearly complete contact, Eqs. (6.40)-(6.54).
 
-    Parameters
-    ----------
-    m0h, m2h, m4h, m6h : float
-        Spectral moments of the surface [length^2], [-], [1/length^2], [1/length^4].
-    sigma0_over_E : float
-        Dugdale stress over E* [-].
-    z0 : float
-        Range of adhesion [length]; the surface energy is w = sigma0 z0
-        (the convention that gives (6.56)).
-    n_elements : int
-        Gauss-Legendre elements (8 points each) per interval between the crack's breakpoints and on
-        the semi-infinite tail.
-    crack_law : {"maugis-dugdale", "jkr"}
-        The single crack: :class:`AdhesiveCrack` at the sigma0* of (6.6), or its limit sigma0 -> inf at
-        the same w, :class:`JKRCrack` (the "JKR limit" curves of Figs. 6.9-6.10). The scales C, C1, C2
-        depend on w alone, so both laws share them.
-
-    All results are dimensionless: p* = pbar/sqrt(m0^p), g* = gbar/sqrt(m0^h).
+    Moments m0h..m6h of the surface [length^2], [-], [1/length^2], [1/length^4]; the surface energy is
+    w = sigma0 z0 ((6.56)), z0 [length]. ``n_elements``: Gauss-Legendre elements per interval between the
+    crack's breakpoints and on the tail. ``crack_law``: :class:`AdhesiveCrack` at the sigma0* of (6.6), or
+    :class:`JKRCrack` ("JKR limit" of Figs. 6.9-6.10). Results: p* = pbar/sqrt(m0^p), g* = gbar/sqrt(m0^h).
     """
 
     XI_CUT = 12.0   # the summit-height density (2.42) is below exp(-C1 xi^2) <= exp(-72) beyond xi* = 12
@@ -369,8 +318,7 @@ class AdhesiveGW:
         """1 - A* and g* at pbar after a loading history that reached pbar_max >= pbar."""
         c = self.crack
         breaks = c.breakpoints()
-        # local p* = (xi - pbar) C; history minimum (xi - pbar_max) C
-        shift = pbar - pbar_max            # <= 0 : p_min = p + shift C
+        shift = pbar - pbar_max            # local p* = (xi - pbar) C, its history minimum p + shift C
         # Breakpoints beyond the summit heights that carry weight are dropped: a far one (E and F recede
         # as sigma0* grows) would stretch the elements of the last interval over the whole density.
         cut = (max(pbar, 0.0) + self.XI_CUT) * self.C
@@ -410,12 +358,8 @@ class AdhesiveGW:
         return 1.0 - out[:, 0], out[:, 1]
 
     def dissipated_energy(self, pstar_max, pstar_min=0.0, n_elements=24):
-        """Area between the loading and unloading g*(p*) curves over [pstar_min, pstar_max] (Fig. 6.11(b)).
-
-        int (g*_loading - g*_unloading) dp*, the energy per unit area dissipated in the cycle down to
-        ``pstar_min`` and back, over sqrt(m0^p) sqrt(m0^h) (the section's "subtraction of the area
-        underneath the loading and unloading stages"). Composite Gauss-Legendre in p*.
-        """
+        """Area between the loading and unloading g*(p*) curves over [pstar_min, pstar_max] (Fig. 6.11(b)): the
+        energy per unit area dissipated in the cycle, over sqrt(m0^p) sqrt(m0^h)."""
         if not pstar_max > pstar_min:
             raise ValueError("pstar_max must exceed pstar_min")
         p, w = gauss_legendre(n_elements, 8, pstar_min, pstar_max)

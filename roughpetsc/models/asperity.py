@@ -1,13 +1,7 @@
-"""Integrals over summit height and curvature shared by all multi-asperity and
-multi-crack models (the dissertation, Eqs. (4.21)-(4.31), (5.35)-(5.46)).
+"""Integrals over summit height and curvature shared by the models of Eqs. (4.21)-(4.31), (5.35)-(5.46).
 
-Every model of chapters 4 and 5 is a sum of terms
-
-    I_j(d) = int_d^inf int  (xi - d)**a_j  W_j(kappa)  Phi(xi, kappa)  dkappa dxi
-
-with a density Phi of section 2.5.  They are evaluated here once, with the
-shared Gauss-Legendre rule of :mod:`.quadrature`, on d-independent nodes in
-``t = xi - d`` so that a whole curve costs one tensor contraction per point.
+Every model of chapters 4 and 5 is a sum of terms I_j(d) = int_d^inf int (xi - d)**a_j W_j(kappa) Phi(xi, kappa)
+dkappa dxi with a density Phi of section 2.5, evaluated on d-independent nodes in ``t = xi - d``.
 """
 
 import numpy as np
@@ -17,25 +11,12 @@ from .quadrature import semi_infinite, unit_interval
 
 __all__ = ["CurvatureRule", "height_integrals", "DEFAULT_ELEMENTS"]
 
-# (height elements, curvature elements[, ratio elements]) with 8 points each:
-# chosen so that Tables 4.1/4.2 are reproduced with a large margin (see tests).
+# (height, curvature[, ratio]) elements of 8 points: Tables 4.1/4.2 with a large margin (see tests).
 DEFAULT_ELEMENTS = {"xi": (10,), "km": (14, 14), "kg": (14, 14), "k1k2": (10, 8, 14)}
 
 
 class CurvatureRule:
-    """Nodes, weights and density of one asperity description.
-
-    Parameters
-    ----------
-    kind : {"xi", "km", "kg", "k1k2"}
-        Density (2.42), (2.40), (2.41) or (2.39).
-    alpha : float
-        Bandwidth parameter (> 3/2).
-    elements : tuple of int, optional
-        Elements per dimension (height first).
-    order : int
-        Gauss points per element.
-    """
+    """Nodes, weights and density (``kind`` "xi", "km", "kg", "k1k2": (2.42), (2.40), (2.41), (2.39))."""
 
     def __init__(self, kind, alpha, elements=None, order=8):
         if kind not in DEFAULT_ELEMENTS:
@@ -71,22 +52,7 @@ class CurvatureRule:
 
 
 def height_integrals(rule, d, terms):
-    """Evaluate ``I_j(d)`` for all separations ``d``.
-
-    Parameters
-    ----------
-    rule : CurvatureRule
-    d : array_like
-        Lower limits of the height integral (d* for early contact, p* for the
-        pressure surface).
-    terms : list of (float, ndarray or None)
-        Height power ``a_j`` and curvature weight ``W_j`` sampled on
-        ``rule.k`` (None means 1).
-
-    Returns
-    -------
-    ndarray, shape (len(terms), len(d))
-    """
+    """``I_j(d)``, shape (len(terms), len(d)), for ``terms`` (a_j, W_j on ``rule.k`` or None for 1)."""
     d = np.atleast_1d(np.asarray(d, dtype=float))
     hw = np.stack([rule.wt * rule.t ** a for a, _ in terms])             # (J, nt)
     kw = np.stack([rule.wk * (1.0 if W is None else W) for _, W in terms])  # (J, nk)

@@ -1,9 +1,6 @@
 """Statistical models of nearly complete contact (the dissertation, chapter 5.3).
 
-Dimensionless variables: ``p* = pbar / sqrt(m0^p)``, mean gap
-``g* = gbar / sqrt(m0^h)``, contact ratio ``A*``.  The models are the
-multi-crack analogues of chapter 4 on the "pressure surface" (bandwidth
-``alpha^p`` (2.54)); g* also depends on ``alpha^h``.
+The multi-crack analogues of chapter 4 on the pressure surface (``alpha^p`` (2.54)); g* also depends on ``alpha^h``.
 """
 
 import numpy as np
@@ -28,26 +25,10 @@ def _ciavarella(p, alpha_h, n_elements=12):
 
 
 def complete(name, pstar, alpha_p, alpha_h, elements=None):
-    """Contact ratio and mean gap of a nearly-complete-contact model.
+    """Contact ratio A* and mean gap g* of a nearly-complete-contact model at p* >= 0 (A* < 0 at small p* possible).
 
-    Parameters
-    ----------
-    name : {"gw", "nayak_bush", "greenwood", "ciavarella"}
-        Adapted GW (5.37)-(5.38), Nayak-Bush (5.41)-(5.42), Greenwood
-        (5.45)-(5.46), Ciavarella asymptotic (5.53)-(5.54).
-    pstar : array_like
-        p* = pbar / sqrt(m0^p) >= 0.
-    alpha_p, alpha_h : float
-        Bandwidths of the pressure surface (2.54) and of the surface (2.16),
-        both > 3/2 (alpha_p is unused by "ciavarella").
-    elements : tuple of int, optional
-        Gauss-Legendre elements per dimension.
-
-    Returns
-    -------
-    A, gstar : ndarray
-        Contact ratio A* [-] and mean gap g* = gbar / sqrt(m0^h) [-].
-        The models may give A* < 0 at small p* (outside their range).
+    ``name``: adapted GW (5.37)-(5.38), Nayak-Bush (5.41)-(5.42), Greenwood (5.45)-(5.46), Ciavarella asymptotic
+    (5.53)-(5.54) (no alpha_p). alpha_p (2.54) and alpha_h (2.16) > 3/2.
     """
     p = np.atleast_1d(np.asarray(pstar, dtype=float))
     if not np.all(np.isfinite(p)):

@@ -1,9 +1,7 @@
 """Pressurised elliptical and penny-shaped cracks (the dissertation, section 5.2).
 
-A non-contact island of the nearly complete contact is a crack loaded by
-p2 = p0 - kappa_1 x^2/2 - kappa_2 y^2/2 (5.4).  Units: p0 and E* [pressure],
-curvatures of the pressure surface [pressure/length^2]; area [length^2],
-volume [length^3].
+A non-contact island of the nearly complete contact is a crack loaded by p2 = p0 - kappa_1 x^2/2 - kappa_2 y^2/2
+(5.4). Units: p0, E* [pressure], curvatures [pressure/length^2], area [length^2], volume [length^3].
 """
 
 import numpy as np
@@ -61,12 +59,9 @@ def I22(e):
 
 
 def F1(e, ratio):
-    """Area correction F1 of Eq. (5.18), as printed.
+    """Area correction F1 of Eq. (5.18), as printed, with Martin's I_20^c = I_02^c in Omega = I00 I22 - I02 I20.
 
-    Omega = I00 I22 - I02 I20 needs I_20^c, which the dissertation does not define; with
-    Martin's symmetric definition I_20^c = I_02^c it is used here.  (Eliminating
-    B2 = 0 from (5.8) and (5.14) gives I02^2 instead of the printed I02 in the
-    bracket; see the study report.)"""
+    (Eliminating B2 = 0 from (5.8) and (5.14) gives I02^2 instead of the printed I02 in the bracket.)"""
     a00, a02, a22 = I00(e), I02(e), I22(e)
     omega = a00 * a22 - a02 * a02
     sr = np.sqrt(ratio)
@@ -83,24 +78,8 @@ def F2(e, ratio):
 
 
 def elliptical(p0, k1, k2, E_star=1.0, method="exact"):
-    """Elliptical crack area and trapped volume, Eqs. (5.17) and (5.23).
-
-    Parameters
-    ----------
-    p0 : array_like
-        Peak tension xi^p - pbar [pressure].
-    k1, k2 : array_like
-        Principal curvatures of the pressure surface, 0 < k1 <= k2 [pressure/length^2].
-    E_star : float
-        Composite modulus [pressure].
-    method : {"exact", "fit"}
-        e from the root of (5.15) or from the fit (5.16).
-
-    Returns
-    -------
-    A, V : ndarray
-        Crack area [length^2] and trapped volume [length^3].
-    """
+    """Elliptical crack area A and trapped volume V, Eqs. (5.17) and (5.23), for the peak tension p0 = xi^p - pbar
+    and curvatures 0 < k1 <= k2; e from the root of (5.15) (``method="exact"``) or the fit (5.16)."""
     k1, k2 = np.asarray(k1, float), np.asarray(k2, float)
     y = k1 / k2
     e = e_exact(y) if method == "exact" else e_fit(y)

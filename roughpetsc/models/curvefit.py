@@ -1,17 +1,9 @@
 """Complete-contact curve fit of A*(p*) (the dissertation, 8.5, Eqs. (8.2)-(8.3), Table 8.4).
 
-A*(p*) = I(p*) f(p*) for p* <= 2 and I(p*) beyond, where I is A* of a nearly-complete-contact model and
-f(p*) = a exp(b p*) + c exp(d p*) with a = -c (so that A*(0) = 0; erratum of docs/conventions.md: the
-sentence after Table 8.4 gives the column means of b, c, d under the names a, b, c).  Continuity at p* = 2
-requires c = 1 / (exp(2 d) - exp(2 b)).
-
-Which model is I (``model=``): by default ``"gw"``, the adapted GW model (5.37) with the summit PDF
-(2.42), the one that reproduces Table 8.4, not the Greenwood model (5.45) that section 8.5 names (erratum of
-docs/conventions.md); see :func:`curvefit_reference` for the others.
-
-Section 8.5 notes that the slope of the fit at p* = 0 should be the asymptotic BGT model's sqrt(pi/2), and
-that (8.3) with two free parameters does not hold it. Held as a third condition, I(0) c (d - b) = sqrt(pi/2)
-fixes d for each b (``slope=`` of :func:`fit_curvefit`), leaving one free parameter.
+A*(p*) = I(p*) f(p*) for p* <= 2 and I(p*) beyond, I the A* of a nearly-complete-contact model (by default the
+adapted GW model (5.37) with (2.42), which reproduces Table 8.4; errata: docs/conventions.md), f(p*) = a exp(b p*)
++ c exp(d p*) with a = -c (A*(0) = 0) and c = 1 / (exp(2 d) - exp(2 b)) (continuity at p* = 2). Holding the slope
+at p* = 0 at the asymptotic BGT model's sqrt(pi/2) fixes d for each b (``slope=`` of :func:`fit_curvefit`).
 """
 
 import numpy as np
@@ -46,22 +38,10 @@ def correction(pstar, b, c, d):
 
 
 def curvefit_reference(pstar, alpha_p, model=CURVEFIT_MODEL):
-    """I(p*) of (8.2): the contact ratio of a nearly-complete-contact model.
+    """I(p*) of (8.2): A* of a nearly-complete-contact model at p* >= 0, alpha^p (2.54) > 3/2.
 
-    Parameters
-    ----------
-    pstar : array_like
-        p* = pbar / sqrt(m0^p) >= 0.
-    alpha_p : float
-        Bandwidth of the pressure surface (2.54), > 3/2 (the PDFs (2.40)-(2.42) take it).
-    model : str or callable
-        A name of :data:`~roughpetsc.models.complete.COMPLETE_MODELS` ("gw" (5.37), the default; "nayak_bush"
-        (5.41); "greenwood" (5.45); "ciavarella" (5.54)), or a function of p* returning A* [-].
-
-    Returns
-    -------
-    ndarray
-        I(p*) [-], A* of the model (its g* is not needed: alpha^h only enters g*).
+    ``model``: a name of :data:`~roughpetsc.models.complete.COMPLETE_MODELS` ("gw" (5.37), "nayak_bush" (5.41),
+    "greenwood" (5.45), "ciavarella" (5.54)) or a function of p* returning A*.
     """
     p = np.atleast_1d(np.asarray(pstar, dtype=float))
     if callable(model):
@@ -72,48 +52,14 @@ def curvefit_reference(pstar, alpha_p, model=CURVEFIT_MODEL):
 
 
 def curvefit_area(pstar, alpha_p, b, c, d, model=CURVEFIT_MODEL):
-    """Curve-fit contact ratio A*(p*), Eq. (8.2).
-
-    Parameters
-    ----------
-    pstar : array_like
-        p* = pbar / sqrt(m0^p) >= 0.
-    alpha_p : float
-        Bandwidth of the pressure surface (2.54), > 3/2.
-    b, c, d : float
-        Parameters of (8.3) (Table 8.4), a = -c.
-    model : str or callable
-        I(p*) (:func:`curvefit_reference`); the default, (5.37) with (2.42), is the one Table 8.4 was fitted with.
-
-    Returns
-    -------
-    ndarray
-        A* [-].
-    """
+    """Curve-fit contact ratio A*(p*), Eq. (8.2), with b, c, d of (8.3) (Table 8.4), I of :func:`curvefit_reference`."""
     p = np.atleast_1d(np.asarray(pstar, dtype=float))
     I = curvefit_reference(p, alpha_p, model)
     return np.where(p <= P_SPLIT, I * correction(p, b, c, d), I)
 
 
 def curvefit_slope_at_zero(alpha_p, b, c, d, model=CURVEFIT_MODEL):
-    """dA*/dp* of the curve fit (8.2)-(8.3) at p* = 0: I(0) c (d - b), since f(0) = 0.
-
-    Section 8.5 says it is close to sqrt(pi/2) (:data:`BGT_SLOPE`), the asymptotic BGT model's.
-
-    Parameters
-    ----------
-    alpha_p : float
-        Bandwidth of the pressure surface (2.54) that I takes.
-    b, c, d : float
-        Parameters of (8.3), a = -c.
-    model : str or callable
-        I(p*) (:func:`curvefit_reference`).
-
-    Returns
-    -------
-    float
-        The slope [-].
-    """
+    """dA*/dp* of the curve fit (8.2)-(8.3) at p* = 0: I(0) c (d - b) (section 8.5: close to :data:`BGT_SLOPE`)."""
     return float(curvefit_reference(np.zeros(1), alpha_p, model)[0]) * c * (d - b)
 
 
@@ -123,11 +69,7 @@ def _continuity_c(b, d):
 
 
 def _d_for_slope(b, slope, I0):
-    """The d != b at which the fit's slope at p* = 0, I(0) c (d - b), equals ``slope``.
-
-    ``(d - b) / (exp(2d) - exp(2b))`` is the reciprocal of the mean of ``2 exp(2x)`` over [b, d], so it
-    falls from +inf (d -> -inf) to 0 (d -> +inf): one root for every b.
-    """
+    """The d != b at which the fit's slope at p* = 0, I(0) c (d - b), equals ``slope`` (one root for every b)."""
     target = slope / I0
 
     def excess(d):
@@ -150,28 +92,9 @@ def _d_for_slope(b, slope, I0):
 def fit_curvefit(pstar, area, alpha_p, guess=(-1.9, -0.05), slope=None, model=CURVEFIT_MODEL):
     """Fit b, c, d of (8.2)-(8.3) to a curve A*(p*) (e.g. a BEM ensemble mean).
 
-    The dissertation's two boundary conditions are built in: a = -c (A*(0) = 0) and
-    c = 1 / (exp(2d) - exp(2b)) (continuity at p* = 2); b and d are found by
-    least squares over the points with p* <= 2. Swapping b and d flips the sign of c and leaves f, so the
-    larger exponent is returned as d.
-
-    Parameters
-    ----------
-    pstar, area : array_like
-        The curve: p* and A* [-] at the same points.
-    alpha_p : float
-        Bandwidth of the pressure surface (2.54) that I(p*) takes.
-    guess : (b, d)
-        Start of the least squares.
-    slope : float, optional
-        If given (for example :data:`BGT_SLOPE`), dA*/dp* at p* = 0, I(0) c (d - b), is held at it: d
-        follows from b, and b alone is fitted.
-    model : str or callable
-        I(p*) (:func:`curvefit_reference`), by default (5.37) with (2.42).
-
-    Returns
-    -------
-    b, c, d : float
+    With a = -c and c from continuity at p* = 2, b and d are found by least squares over the points with
+    p* <= 2 from ``guess``; the larger exponent is returned as d. ``slope`` (e.g. :data:`BGT_SLOPE`) holds
+    dA*/dp* at p* = 0: d follows from b, and b alone is fitted.
     """
     p = np.asarray(pstar, dtype=float)
     A = np.asarray(area, dtype=float)
@@ -203,23 +126,8 @@ def fit_curvefit(pstar, area, alpha_p, guess=(-1.9, -0.05), slope=None, model=CU
 def bootstrap_curvefit(pstar, samples, alpha_p, resamples=400, seed=0, slope=None, model=CURVEFIT_MODEL):
     """The fit of :func:`fit_curvefit` to the mean of ``samples`` and its spread over the surfaces.
 
-    Parameters
-    ----------
-    pstar : (steps,) array_like
-        The load steps (p*) shared by every surface.
-    samples : (surfaces, steps) array_like
-        A* of each surface of an ensemble at each step.
-    resamples : int
-        Bootstrap resamples: surfaces drawn with replacement, their mean fitted again.
-    seed : int
-        Seed of the resampling.
-    slope, model :
-        As in :func:`fit_curvefit`.
-
-    Returns
-    -------
-    fit : (b, c, d) of the ensemble mean
-    draws : (resamples, 3) ndarray of the refits (percentiles of its columns are confidence intervals)
+    ``samples`` (surfaces, steps) holds A* at the load steps ``pstar``. Returns ``fit`` (b, c, d) of the mean and
+    ``draws`` (resamples, 3), the refits of the means of surfaces drawn with replacement.
     """
     samples = np.asarray(samples, dtype=float)
     fit = fit_curvefit(pstar, samples.mean(axis=0), alpha_p, slope=slope, model=model)

@@ -1,8 +1,6 @@
 """Statistical models of early contact (the dissertation, chapter 4).
 
-Dimensionless variables: separation ``d* = d / sqrt(m0^h)``, pressure
-``p* = pbar / sqrt(m0^p) = pbar / (E* sqrt(m2^h / 2))``, contact ratio ``A*``.
-Every model depends on the bandwidth ``alpha^h`` (2.16) only.
+Dimensionless variables as in :mod:`roughpetsc.models`; every model depends on the bandwidth ``alpha^h`` (2.16) only.
 """
 
 import numpy as np
@@ -25,8 +23,7 @@ TABLE_4_1 = {
                          [2.218e-1, 1.339e-1, 6.967e-2, 3.010e-2, 1.052e-2, 2.931e-3, 6.463e-4]),
     ("bgt", 10.0): ([2.040e-1, 1.174e-1, 5.809e-2, 2.415e-2, 8.269e-3, 2.297e-3, 5.120e-4],
                     [3.680e-1, 1.950e-1, 8.940e-2, 3.471e-2, 1.120e-2, 2.956e-3, 6.308e-4]),
-    # Table 4.1 prints 8.403e-2 for Greenwood, alpha 10, d* = 2: the exponent is an
-    # obvious typo (the [16] column and the monotone column say 8.403e-3).
+    # Table 4.1 prints 8.403e-2 for Greenwood, alpha 10, d* = 2: a typo (the [16] column says 8.403e-3).
     ("greenwood", 10.0): ([2.079e-1, 1.195e-1, 5.912e-2, 2.456e-2, 8.403e-3, 2.333e-3, 5.194e-4],
                           [3.588e-1, 1.902e-1, 8.730e-2, 3.393e-2, 1.096e-2, 2.896e-3, 6.188e-4]),
     ("nayak_bush", 2.0): ([1.449e-1, 9.593e-2, 5.425e-2, 2.507e-2, 9.210e-3, 2.657e-3, 6.003e-4],
@@ -76,38 +73,18 @@ def _evaluate(name, dstar, alpha_h, elements, e_method, slope):
 
 
 def early(name, dstar, alpha_h, elements=None, e_method="exact"):
-    """Contact ratio and pressure of an early-contact model as functions of d*.
+    """Contact ratio A* and pressure p* of an early-contact model at the separations d*, alpha^h > 3/2 (2.16).
 
-    Parameters
-    ----------
-    name : {"gw", "nayak_bush", "greenwood", "bgt", "bgt_asymptotic"}
-        Adapted GW (4.23)/(4.25), Nayak-Bush (4.26)-(4.27), Greenwood
-        (4.28)-(4.29), BGT (4.30)-(4.31) or asymptotic BGT (4.32)/(4.34).
-    dstar : array_like
-        Dimensionless separation d* = d / sqrt(m0^h) (any real value).
-    alpha_h : float
-        Bandwidth parameter alpha^h > 3/2 (2.16).
-    elements : tuple of int, optional
-        Gauss-Legendre elements per dimension (accuracy control).
-    e_method : {"exact", "fit"}
-        BGT only: eccentricity from the exact root of (4.10) (default; it
-        reproduces Table 4.1) or from the fit (4.11) that the dissertation mentions
-        below (4.31) (differs by up to ~2e-5 relative).
-
-    Returns
-    -------
-    A, pstar : ndarray
-        Contact ratio A* [-] and p* = pbar / sqrt(m0^p) [-].
+    ``name``: adapted GW (4.23)/(4.25), Nayak-Bush (4.26)-(4.27), Greenwood (4.28)-(4.29), BGT (4.30)-(4.31) or
+    asymptotic BGT (4.32)/(4.34). ``elements``: Gauss-Legendre elements per dimension. ``e_method`` (BGT): the
+    eccentricity from the root of (4.10) (reproduces Table 4.1) or from the fit (4.11) (up to ~2e-5 apart).
     """
     A, p, _ = _evaluate(name, dstar, alpha_h, elements, e_method, False)
     return A, p
 
 
 def early_separation(name, pstar, alpha_h, elements=None, e_method="exact", iterations=60):
-    """Invert p*(d*) of an early-contact model: returns (d*, A*) at given p* > 0.
-
-    Safeguarded Newton iteration on ln p* with the exact slope
-    dp*/dd* = -(3/2) c_P int (xi - d)^(1/2) ... (same quadrature)."""
+    """Invert p*(d*) of an early-contact model: (d*, A*) at p* > 0, by safeguarded Newton on ln p*."""
     p_t = np.atleast_1d(np.asarray(pstar, dtype=float))
     if np.any(~np.isfinite(p_t)) or np.any(p_t <= 0):
         raise ValueError("p* must be positive and finite")

@@ -1,9 +1,7 @@
 """Eccentricity of elliptical contacts and cracks from a curvature ratio.
 
-Shared by the Hertz elliptical contact (4.10)-(4.11) and the elliptical crack
-(5.15)-(5.16): both give the curvature ratio ``y = kappa_1/kappa_2`` (0 < y <= 1)
-as an explicit, monotone function of the eccentricity ``e``; the inverse is found
-by a vectorised bisection in ``z = ln(1 - e^2)``.
+Shared by the Hertz contact (4.10)-(4.11) and the crack (5.15)-(5.16): both give ``y = kappa_1/kappa_2`` in
+(0, 1] as a monotone function of ``e``, inverted by bisection in ``z = ln(1 - e^2)``.
 """
 
 import numpy as np
@@ -13,9 +11,7 @@ __all__ = ["elliptic_KE", "ratio_of_eccentricity", "invert_ratio", "fit_sqrt1me2
 
 
 def elliptic_KE(z):
-    """Complete elliptic integrals K(e), E(e) for ``1 - e^2 = exp(z)`` (z <= 0).
-
-    ``ellipkm1`` keeps K accurate as e -> 1 (scipy uses the parameter m = e^2)."""
+    """Complete elliptic integrals K(e), E(e) for ``1 - e^2 = exp(z)`` (``ellipkm1``: K accurate as e -> 1)."""
     p = np.exp(z)                      # 1 - e^2
     return ellipkm1(p), ellipe(1.0 - p), p
 
@@ -28,9 +24,7 @@ def ratio_of_eccentricity(ratio_of_z, e):
 
 
 def invert_ratio(ratio_of_z, ratio, z_min=-80.0, iterations=80):
-    """Solve ``ratio_of_z(z) = ratio`` for z = ln(1 - e^2) by vectorised bisection.
-
-    ``ratio_of_z`` must increase from 0 (z -> -inf) to 1 (z = 0).  Returns e."""
+    """e solving ``ratio_of_z(z) = ratio``, z = ln(1 - e^2), ``ratio_of_z`` increasing from 0 to 1 (z = 0)."""
     ratio = np.asarray(ratio, dtype=float)
     if np.any((ratio <= 0) | (ratio > 1)):
         raise ValueError("curvature ratio kappa_1/kappa_2 must lie in (0, 1]")

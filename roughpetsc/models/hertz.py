@@ -55,24 +55,8 @@ def F2(e):
 
 
 def elliptical(delta, k1, k2, E_star=1.0, method="exact"):
-    """Hertz elliptical contact, Eqs. (4.6)-(4.7).
-
-    Parameters
-    ----------
-    delta : array_like
-        Penetration [length].
-    k1, k2 : array_like
-        Principal curvatures, 0 < k1 <= k2 [1/length].
-    E_star : float
-        Composite modulus (1.6) [pressure].
-    method : {"exact", "fit"}
-        Eccentricity from the root of (4.10) or from the fit (4.11).
-
-    Returns
-    -------
-    A, P : ndarray
-        Contact area [length^2] and load [force].
-    """
+    """Hertz elliptical contact area A and load P, Eqs. (4.6)-(4.7), for curvatures 0 < k1 <= k2; the eccentricity
+    from the root of (4.10) (``method="exact"``) or the fit (4.11)."""
     k1, k2 = np.asarray(k1, float), np.asarray(k2, float)
     e = e_exact(k1 / k2) if method == "exact" else e_fit(k1 / k2)
     kg = np.sqrt(k1 * k2)

@@ -1,10 +1,7 @@
 """Asperity probability densities of an isotropic Gaussian surface (the dissertation, 2.5, 7.2.2).
 
-All densities are in the dimensionless variables of Eq. (2.34): summit height
-``xi = xi^h / sqrt(m0)`` and curvatures ``kappa = kappa^h / sqrt(m4)``; they are
-normalised per asperity (they integrate to one), and depend on the bandwidth
-``alpha = m0 m4 / m2**2`` (2.16) only, which must exceed 3/2.  The same functions
-serve the "pressure surface" with ``alpha^p`` (section 2.6).
+In the variables of Eq. (2.34), ``xi = xi^h / sqrt(m0)``, ``kappa = kappa^h / sqrt(m4)``, normalised per
+asperity; they depend on ``alpha`` (2.16) > 3/2 only, ``alpha^p`` for the pressure surface (section 2.6).
 """
 
 import numpy as np
@@ -26,8 +23,7 @@ def c1(alpha):
 
 
 def phi_xi_km_kd(xi, km, kd, alpha):
-    """Joint density of summit height, mean and semi-difference curvature, Eq. (2.38)
-    (support ``0 <= kd <= km``)."""
+    """Joint density of summit height, mean and semi-difference curvature, Eq. (2.38), 0 <= kd <= km."""
     C1 = c1(alpha)
     val = (27.0 / (2.0 * np.pi) * np.sqrt(C1)
            * np.exp(-C1 * (xi - 1.5 * km / np.sqrt(alpha)) ** 2
@@ -37,8 +33,7 @@ def phi_xi_km_kd(xi, km, kd, alpha):
 
 
 def phi_xi_k1k2(xi, k1, k2, alpha):
-    """Joint density of summit height and principal curvatures, Eq. (2.39)
-    (support ``0 <= k1 <= k2``)."""
+    """Joint density of summit height and principal curvatures, Eq. (2.39), 0 <= k1 <= k2."""
     C1 = c1(alpha)
     val = (27.0 / (8.0 * np.pi) * np.sqrt(C1)
            * np.exp(-C1 * (xi - 0.75 * (k1 + k2) / np.sqrt(alpha)) ** 2
@@ -48,8 +43,7 @@ def phi_xi_k1k2(xi, k1, k2, alpha):
 
 
 def phi_xi_km(xi, km, alpha):
-    """Joint density of summit height and mean curvature, Eq. (2.40)
-    with C2 = C1 sqrt(12/alpha)."""
+    """Joint density of summit height and mean curvature, Eq. (2.40), C2 = C1 sqrt(12/alpha)."""
     C1 = c1(alpha)
     C2 = C1 * np.sqrt(12.0 / alpha)
     bracket = 3.0 * km ** 2 - 2.0 + 2.0 * np.exp(-1.5 * km ** 2)
@@ -60,10 +54,7 @@ def phi_xi_km(xi, km, alpha):
 
 
 def phi_xi_kg(xi, kg, alpha):
-    """Joint density of summit height and geometric curvature, Eq. (2.41).
-
-    The product ``erfc(x) exp(3 kg^2/2)`` is formed through ``erfcx`` to avoid
-    overflow at large ``kg``."""
+    """Joint density of summit height and geometric curvature, Eq. (2.41) (through ``erfcx``, no overflow)."""
     _check_alpha(alpha)
     mu = np.sqrt(0.5 * (alpha - 1.0) / (2.0 * alpha - 3.0))
     x = mu * (3.0 * kg - xi * np.sqrt(alpha) / (alpha - 1.0))

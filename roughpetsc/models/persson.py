@@ -1,7 +1,6 @@
 """Persson's model (the dissertation, section 5.4 and appendix E).
 
-``psd_amplitude`` is the amplitude C of the PSD (2.18) from m2^h, eq. (7.1):
-:func:`roughpetsc.surfaces.fractal_amplitude`, re-exported here under the name the models use.
+``psd_amplitude`` is C of the PSD (2.18) from m2^h, eq. (7.1) (:func:`roughpetsc.surfaces.fractal_amplitude`).
 """
 
 import numpy as np
@@ -15,45 +14,21 @@ __all__ = ["persson_area", "persson_gap", "psd_amplitude", "fractal_moments"]
 
 
 def persson_area(pstar):
-    """Contact ratio A* = 1 - erfc(p*/sqrt 2) = erf(p*/sqrt 2), Eq. (5.59);
-    p* = pbar / sqrt(m0^p)."""
+    """Contact ratio A* = 1 - erfc(p*/sqrt 2) = erf(p*/sqrt 2), Eq. (5.59)."""
     return erf(np.asarray(pstar, dtype=float) / np.sqrt(2.0))
 
 
 def fractal_moments(k_l, k_s, H, C):
-    """Moments m0, m2, m4, m6 of the PSD (2.18) with k_r = k_l, Eq. (2.20) (:func:`roughpetsc.spectra.fractal_height_moment`)."""
+    """Moments m0, m2, m4, m6 of the PSD (2.18) with k_r = k_l, Eq. (2.20)."""
     return tuple(fractal_height_moment(n, k_l, k_s, H, C) for n in (0, 2, 4, 6))
 
 
 def persson_gap(pstar, k_l, k_s, H, m2, E_star, gamma=1.0, n_elements=32, order=8):
-    """Persson's mean interfacial gap, appendix E, Eq. (E.7) (k from k_l to k_s).
+    """Persson's mean interfacial gap g* at p* > 0, appendix E, Eq. (E.7) (k from k_l to k_s).
 
-    The inner pressure integral is exact, int_p^inf exp(-p'^2/(2 m0p(k))) dp'/p'
-    = E1(p^2 / (2 m0p(k))) / 2; the wavenumber integral uses the shared
-    Gauss-Legendre rule in v with k = k_l exp(v^2), which removes the
-    (k - k_l)^(-1/2) endpoint behaviour of 1/sqrt(m0p(k)).
-
-    Parameters
-    ----------
-    pstar : array_like
-        p* = pbar / sqrt(m0^p) > 0 with m0^p = E*^2 m2 / 2 (2.53).
-    k_l, k_s : float
-        Cut-off wavenumbers [1/length] (cycles per length), 0 < k_l < k_s.
-    H : float
-        Hurst exponent, 0 < H < 1.
-    m2 : float
-        Slope moment m2^h [-] of the whole spectrum (fixes C by (7.1)).
-    E_star : float
-        Composite modulus [pressure] (g* does not depend on it).
-    gamma : float
-        Persson's energy factor of (E.2).
-    n_elements, order : int
-        Gauss-Legendre elements / points in ln k.
-
-    Returns
-    -------
-    gstar : ndarray
-        g* = gbar / sqrt(m0^h) [-].
+    The inner pressure integral is exact, E1(p^2 / (2 m0p(k))) / 2; the wavenumber integral uses the shared
+    rule in v with k = k_l exp(v^2), which removes the (k - k_l)^(-1/2) endpoint behaviour of 1/sqrt(m0p(k)).
+    ``k_l``, ``k_s`` in cycles per length, ``m2`` fixes C by (7.1), ``gamma`` is Persson's factor of (E.2).
     """
     p = np.atleast_1d(np.asarray(pstar, dtype=float))
     if np.any(~(p > 0)) or not (0 < k_l < k_s) or not (0 < H < 1) or not (m2 > 0) or not (E_star > 0):

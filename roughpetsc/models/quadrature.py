@@ -18,22 +18,8 @@ def _reference(order):
 
 
 def gauss_legendre(n_elements, order=8, a=0.0, b=1.0):
-    """Composite Gauss-Legendre nodes and weights on ``[a, b]``.
-
-    Parameters
-    ----------
-    n_elements : int
-        Number of equal elements (the accuracy control, Eqs. (4.36)-(4.38)).
-    order : int
-        Gauss points per element (the dissertation uses 4).
-    a, b : float
-        Interval limits.
-
-    Returns
-    -------
-    nodes, weights : ndarray, shape (n_elements * order,)
-        ``sum(weights * f(nodes))`` approximates the integral of ``f`` over ``[a, b]``.
-    """
+    """Composite Gauss-Legendre nodes and weights on ``[a, b]``: ``n_elements`` equal elements (the accuracy
+    control, Eqs. (4.36)-(4.38)) of ``order`` points (the dissertation uses 4)."""
     if n_elements < 1 or order < 1:
         raise ValueError("n_elements and order must be positive")
     x, w = _reference(order)
@@ -46,16 +32,9 @@ def gauss_legendre(n_elements, order=8, a=0.0, b=1.0):
 
 
 def semi_infinite(n_elements, order=8, scale=1.0, power=2):
-    """Nodes and weights for ``int_0^inf f(t) dt`` on the transformed domain.
+    """Nodes and weights for ``int_0^inf f(t) dt`` with ``t = scale * ((1 - u) / u)**power``, u in (0, 1].
 
-    ``t = scale * ((1 - u) / u)**power``, ``u`` in ``(0, 1]`` split into
-    ``n_elements`` Gauss-Legendre elements; the Jacobian is folded into the
-    weights.  Integrands must decay faster than any power of ``t``
-    (all model integrands carry a Gaussian factor).
-
-    Returns
-    -------
-    t, weights : ndarray
+    Integrands must decay faster than any power of ``t`` (the models' carry a Gaussian factor).
     """
     u, w = gauss_legendre(n_elements, order, 0.0, 1.0)
     s = (1.0 - u) / u
@@ -65,7 +44,6 @@ def semi_infinite(n_elements, order=8, scale=1.0, power=2):
 
 
 def unit_interval(n_elements, order=8, power=1):
-    """Nodes and weights on ``[0, 1]`` with ``y = w**power`` (``power > 1``
-    removes an algebraic endpoint singularity at ``y = 0``)."""
+    """Nodes and weights on ``[0, 1]`` with ``y = w**power`` (``power > 1``: for a singularity at ``y = 0``)."""
     x, w = gauss_legendre(n_elements, order, 0.0, 1.0)
     return x ** power, w * power * x ** (power - 1)

@@ -1,14 +1,10 @@
 """Adhesive contact of an elastic sphere and a flat: JKR, DMT and Maugis-Dugdale.
 
-Reference solutions for validating adhesive boundary-element runs.  A rigid
-paraboloid ``z = r^2 / (2 R)`` (or two elastic spheres of reduced radius R)
-touches an elastic half-space of composite modulus ``E_star`` (1.6); ``w`` is
-the work of adhesion (Dupre energy).
+Reference solutions for adhesive boundary-element runs: a rigid paraboloid ``z = r^2 / (2 R)`` on a half-space
+of composite modulus ``E_star`` (1.6), work of adhesion ``w``.
 
-Units: lengths ``a``, ``c``, ``R`` [length], approach ``delta`` [length]
-(positive = interpenetration of the undeformed profiles), ``E_star`` and
-``sigma0`` [pressure], ``w`` [energy/area = pressure * length], loads ``P``
-[force], positive compressive.
+Units: ``a``, ``c``, ``R`` and the approach ``delta`` (positive = interpenetration) [length], ``E_star`` and
+``sigma0`` [pressure], ``w`` [energy/area], loads ``P`` [force], positive compressive.
 
 Sources ([JKR], [DMT], [M92], [JG97]) and the Maugis-Dugdale equations in the notation of [M92]/[JG97]
 (scales a_s, P_s, d_s; lambda; [M92] (6.17)): docs/models.md.
@@ -31,24 +27,20 @@ def _K(E_star):
 
 # ---------------------------------------------------------------------- JKR
 def jkr_load(a, R, E_star, w):
-    """JKR load P(a) = 4 E* a^3/(3 R) - sqrt(8 pi w E* a^3) [force].
-
-    [JKR], i.e. P = K a^3/R - sqrt(6 pi w K a^3) with K = 4 E*/3."""
+    """JKR load P(a) = 4 E* a^3/(3 R) - sqrt(8 pi w E* a^3) [force], [JKR]."""
     a = np.asarray(a, float)
     return 4.0 * E_star * a ** 3 / (3.0 * R) - np.sqrt(8.0 * np.pi * w * E_star * a ** 3)
 
 
 def jkr_approach(a, R, E_star, w):
-    """JKR approach delta(a) = a^2/R - sqrt(2 pi w a / E*) [length], [JKR]
-    (= a^2/R - (2/3) sqrt(6 pi w a / K))."""
+    """JKR approach delta(a) = a^2/R - sqrt(2 pi w a / E*) [length], [JKR]."""
     a = np.asarray(a, float)
     return a ** 2 / R - np.sqrt(2.0 * np.pi * w * a / E_star)
 
 
 def jkr_contact_radius(P, R, E_star, w):
-    """Stable-branch JKR contact radius [length] at load P >= -3/2 pi w R:
-    a^3 = (R/K) [P + 3 pi w R + sqrt(6 pi w R P + (3 pi w R)^2)] [JKR].
-    NaN below the load-control pull-off."""
+    """Stable-branch JKR contact radius [length] at load P >= -3/2 pi w R (else NaN), [JKR]:
+    a^3 = (R/K) [P + 3 pi w R + sqrt(6 pi w R P + (3 pi w R)^2)]."""
     P = np.asarray(P, float)
     q = 3.0 * np.pi * w * R
     disc = 6.0 * np.pi * w * R * P + q * q
@@ -59,9 +51,8 @@ def jkr_contact_radius(P, R, E_star, w):
 
 
 def jkr_pressure(r, a, R, E_star, w):
-    """JKR contact pressure [pressure], positive compressive, for r < a (0 outside):
-    Hertz (2 E* a/(pi R)) sqrt(1 - r^2/a^2) minus the flat-punch term
-    sqrt(2 E* w/(pi a)) / sqrt(1 - r^2/a^2) (stress intensity K = sqrt(2 E* w))."""
+    """JKR contact pressure [pressure] for r < a (0 outside): Hertz (2 E* a/(pi R)) sqrt(1 - r^2/a^2) minus the
+    flat-punch term sqrt(2 E* w/(pi a)) / sqrt(1 - r^2/a^2)."""
     r = np.asarray(r, float)
     inside = np.abs(r) < a
     s = np.sqrt(np.where(inside, 1.0 - (r / a) ** 2, 1.0))
@@ -70,39 +61,22 @@ def jkr_pressure(r, a, R, E_star, w):
 
 
 def jkr_pulloff_load_control(R, E_star, w):
-    """Load-control pull-off of JKR: minimum of P(a) (dP/da = 0).
-
-    Returns
-    -------
-    P, a, delta : float
-        P = -3/2 pi w R [force] at a^3 = 9 pi w R^2 / (8 E*) [length^3]
-        [JKR]; delta = jkr_approach(a) = -(3 pi^2 w^2 R / (64 E*^2))^(1/3).
-    """
+    """Load-control pull-off of JKR, the minimum of P(a): P = -3/2 pi w R at a^3 = 9 pi w R^2 / (8 E*) [JKR],
+    returned as (P, a, delta)."""
     a = np.cbrt(9.0 * np.pi * w * R ** 2 / (8.0 * E_star))
     return -1.5 * np.pi * w * R, a, float(jkr_approach(a, R, E_star, w))
 
 
 def jkr_pulloff_displacement_control(R, E_star, w):
-    """Displacement-control (rigid grips) separation point of JKR.
-
-    Under a controlled approach the equilibrium curve is followed past the
-    load minimum (-3/2 pi w R stays the largest tensile force met on the way)
-    down to the minimum of delta(a), d delta/da = 0, where the contact snaps
-    off: a^3 = pi w R^2 / (8 E*) (a = a_c / 9^(1/3), a_c of load control),
-    P = -5/6 pi w R and delta = -(3/4) (pi^2 w^2 R / E*^2)^(1/3).
-
-    Returns
-    -------
-    P [force], a [length], delta [length]
-    """
+    """Displacement-control separation point of JKR, the minimum of delta(a), as (P, a, delta):
+    a^3 = pi w R^2 / (8 E*), P = -5/6 pi w R, delta = -(3/4) (pi^2 w^2 R / E*^2)^(1/3)."""
     a = np.cbrt(np.pi * w * R ** 2 / (8.0 * E_star))
     return -5.0 / 6.0 * np.pi * w * R, a, -0.75 * np.cbrt(np.pi ** 2 * w ** 2 * R / E_star ** 2)
 
 
 # ---------------------------------------------------------------------- DMT
 def dmt_load(a, R, E_star, w):
-    """DMT load P = 4 E* a^3/(3 R) - 2 pi w R [force] ([DMT]; Hertz plus a constant
-    adhesive force outside the contact)."""
+    """DMT load P = 4 E* a^3/(3 R) - 2 pi w R [force], [DMT]."""
     return 4.0 * E_star * np.asarray(a, float) ** 3 / (3.0 * R) - 2.0 * np.pi * w * R
 
 
@@ -118,14 +92,12 @@ def dmt_pulloff(R, w):
 
 # ----------------------------------------------------------- Maugis-Dugdale
 def maugis_parameter(R, E_star, w, sigma0):
-    """Maugis' transition parameter lambda = 2 sigma0 (R/(pi w K^2))^(1/3), K = 4E*/3,
-    i.e. lambda = sigma0 (9 R / (2 pi w E*^2))^(1/3) [-]; [M92], [JG97]."""
+    """Maugis' transition parameter lambda = 2 sigma0 (R/(pi w K^2))^(1/3), K = 4E*/3 [-]; [M92], [JG97]."""
     return 2.0 * sigma0 * np.cbrt(R / (np.pi * w * _K(E_star) ** 2))
 
 
 def md_scales(R, E_star, w):
-    """Maugis' units (a_s [length], P_s [force], d_s [length]) of A, Pbar, Delta:
-    a_s = (pi w R^2/K)^(1/3), P_s = pi w R, d_s = (pi^2 w^2 R/K^2)^(1/3)."""
+    """Maugis' units of A, Pbar, Delta: a_s = (pi w R^2/K)^(1/3), P_s = pi w R, d_s = (pi^2 w^2 R/K^2)^(1/3)."""
     K = _K(E_star)
     return (np.cbrt(np.pi * w * R ** 2 / K), np.pi * w * R,
             np.cbrt(np.pi ** 2 * w ** 2 * R / K ** 2))
@@ -172,28 +144,13 @@ def _solve_mu(A, lam):
 
 
 def md_cohesive_ratio(A, lam):
-    """m = c/a solving Maugis' equation [M92] (6.17) for dimensionless contact
-    radius A > 0 and transition parameter lambda > 0 (unique root, m >= 1:
-    the left side increases with m)."""
+    """m = c/a >= 1 solving Maugis' equation [M92] (6.17) for A > 0 and lambda > 0 (unique root)."""
     mu = _solve_mu(np.atleast_1d(np.asarray(A, float)), lam)
     return np.sqrt(1.0 + mu * mu)
 
 
 def md_dimensionless(A, lam):
-    """Maugis-Dugdale curve in Maugis' units [M92]/[JG97].
-
-    Parameters
-    ----------
-    A : array_like
-        Contact radius a / (pi w R^2/K)^(1/3) [-], > 0.
-    lam : float
-        Maugis parameter lambda [-].
-
-    Returns
-    -------
-    Pbar, Delta, m : ndarray
-        Load P/(pi w R), approach delta/(pi^2 w^2 R/K^2)^(1/3), and m = c/a.
-    """
+    """Maugis-Dugdale curve (Pbar, Delta, m = c/a) in Maugis' units (:func:`md_scales`) at A > 0 [M92]/[JG97]."""
     A = np.atleast_1d(np.asarray(A, float))
     mu = _solve_mu(A, lam)
     m = np.sqrt(1.0 + mu * mu)
@@ -203,16 +160,10 @@ def md_dimensionless(A, lam):
 
 
 def md_zero_contact(lam):
-    """Limit A -> 0 of the Maugis-Dugdale curve (contact shrunk to a point,
-    Dugdale zone of finite radius C = A m).
+    """Limit A -> 0 of the Maugis-Dugdale curve, Dugdale zone of radius C = A m: (Pbar, Delta, C).
 
-    Expanding [M92] (6.17) for m -> inf at fixed C = A m:
-    (pi lambda/4) C^2 + (4 lambda^2/3)(pi/2 - 1) C = 1, and
-    Pbar -> -(pi lambda/2) C^2, Delta -> -(4/3) lambda C.
-
-    Returns
-    -------
-    Pbar, Delta, C : float
+    [M92] (6.17) for m -> inf: (pi lambda/4) C^2 + (4 lambda^2/3)(pi/2 - 1) C = 1, Pbar -> -(pi lambda/2) C^2,
+    Delta -> -(4/3) lambda C.
     """
     qa, qb = np.pi * lam / 4.0, 4.0 * lam * lam / 3.0 * (np.pi / 2.0 - 1.0)
     C = 2.0 / (qb + np.sqrt(qb * qb + 4.0 * qa))
@@ -220,19 +171,8 @@ def md_zero_contact(lam):
 
 
 def md_pulloff_dimensionless(lam, A_max=4.0, n=400):
-    """Load-control pull-off Pbar_c(lambda) = min over the Maugis-Dugdale curve
-    (A in (0, A_max], including the A -> 0 end of md_zero_contact) [-].
-
-    Goes from -2 (DMT, lambda -> 0) to -3/2 (JKR, lambda -> inf).  The minimum
-    is interior for all lambda tried (1e-3 ... 1e3; A_c ~ 2 lambda for small
-    lambda, A_c -> (3/2)^(1/3) for large), the A -> 0 end is kept as a candidate.
-    Non-contact states (a = 0, surfaces apart) are not modelled.
-
-    Returns
-    -------
-    Pbar_c, A_c : float
-        Pull-off load and the contact radius where it is reached (0 for the end).
-    """
+    """Load-control pull-off (Pbar_c, A_c): the minimum over the Maugis-Dugdale curve for A in (0, A_max] and its
+    A -> 0 end (A_c = 0); from -2 (DMT, lambda -> 0) to -3/2 (JKR, lambda -> inf)."""
     A = np.geomspace(1e-4, A_max, n)
     P = md_dimensionless(A, lam)[0]
     P0 = md_zero_contact(lam)[0]
@@ -250,21 +190,7 @@ def md_pulloff_dimensionless(lam, A_max=4.0, n=400):
 
 
 def md_curve(a, R, E_star, w, sigma0):
-    """Maugis-Dugdale load, approach and Dugdale-zone radius at contact radius a.
-
-    Parameters
-    ----------
-    a : array_like
-        Contact radius [length], > 0.
-    R, E_star, w, sigma0 : float
-        Sphere radius [length], composite modulus [pressure], work of adhesion
-        [energy/area], Dugdale stress [pressure] (range h0 = w/sigma0).
-
-    Returns
-    -------
-    P [force], delta [length], c [length] : ndarray
-        From md_dimensionless with A = a/a_s, lambda = maugis_parameter(...).
-    """
+    """Maugis-Dugdale load P [force], approach delta and Dugdale-zone radius c [length] at contact radius a > 0."""
     lam = maugis_parameter(R, E_star, w, sigma0)
     a_s, P_s, d_s = md_scales(R, E_star, w)
     a = np.atleast_1d(np.asarray(a, float))
@@ -273,10 +199,8 @@ def md_curve(a, R, E_star, w, sigma0):
 
 
 def md_pressure(r, a, c, R, E_star, sigma0):
-    """Maugis-Dugdale surface pressure [pressure] (positive compressive) at radius r,
-    for contact radius a and Dugdale radius c (from md_curve):
-    Hertz(a) - (2 sigma0/pi) arctan sqrt((c^2 - a^2)/(a^2 - r^2)) in r < a,
-    -sigma0 in a < r < c, 0 beyond [M92]."""
+    """Maugis-Dugdale surface pressure [pressure] at radius r for the radii a, c of :func:`md_curve` [M92]:
+    Hertz(a) - (2 sigma0/pi) arctan sqrt((c^2 - a^2)/(a^2 - r^2)) in r < a, -sigma0 in a < r < c, 0 beyond."""
     r = np.abs(np.asarray(r, float))
     inside = r < a
     d = np.where(inside, a * a - r * r, 1.0)
@@ -286,8 +210,6 @@ def md_pressure(r, a, c, R, E_star, sigma0):
 
 
 def md_pulloff(R, E_star, w, sigma0):
-    """Load-control pull-off load of the Maugis-Dugdale model [force]:
-    pi w R * md_pulloff_dimensionless(lambda)[0]; between -2 pi w R (DMT) and
-    -3/2 pi w R (JKR)."""
+    """Load-control pull-off load of the Maugis-Dugdale model [force], between -2 pi w R and -3/2 pi w R."""
     lam = maugis_parameter(R, E_star, w, sigma0)
     return np.pi * w * R * md_pulloff_dimensionless(lam)[0]

@@ -1,16 +1,11 @@
 r"""Adhesive contact of a 1-D sinusoidal (wavy) surface and a flat, plane strain.
 
-Reference solutions for validating periodic adhesive boundary-element runs.
-Profile h(x) = h cos(2 pi x / lam) (peak at x = 0, wave along x, uniform in y),
-composite modulus ``E_star`` (1.6), work of adhesion ``w``; contact in
-|x| < a (mod lam).  ``pbar`` is the mean pressure over a period (positive
-compressive); ``gbar`` the mean gap, i.e. the separation of the mean planes
-(the quantity an FFT boundary-element code controls when the k = 0
-displacement mode is zero).
+Reference solutions for periodic adhesive boundary-element runs. Profile h(x) = h cos(2 pi x / lam), composite
+modulus ``E_star`` (1.6), work of adhesion ``w``; contact in |x| < a (mod lam). ``pbar`` is the mean pressure
+(positive compressive), ``gbar`` the mean gap (the separation of the mean planes).
 
-Units: ``x``, ``a``, ``c``, ``lam``, ``h`` [length]; ``E_star``, ``sigma0``,
-``pbar``, ``p`` [pressure]; ``w`` [energy/area]; stress intensity [pressure *
-length^(1/2)].
+Units: ``x``, ``a``, ``c``, ``lam``, ``h`` [length]; ``E_star``, ``sigma0``, ``pbar``, ``p`` [pressure];
+``w`` [energy/area]; stress intensity [pressure * length^(1/2)].
 
 Sources ([J95], [W39], [K59], [CM04], [H01], [JWG16], [BH97]) and the derivation of the JKR wave and its
 stationary points: docs/models.md.
@@ -58,8 +53,7 @@ def westergaard_mean_pressure(a, lam, h, E_star):
 
 
 def westergaard_mean_gap(a, lam, h):
-    """Westergaard mean gap h [cos^2 psi + sin^2 psi ln sin^2 psi] [length]
-    (= h (1 - P + P ln P), P = pbar/p*; [CM04] Eq. (39) with alpha = 0)."""
+    """Westergaard mean gap h [cos^2 psi + sin^2 psi ln sin^2 psi] [length], [CM04] Eq. (39) with alpha = 0."""
     psi = _psi(a, lam)
     s2 = np.sin(psi) ** 2
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -68,8 +62,7 @@ def westergaard_mean_gap(a, lam, h):
 
 
 def westergaard_pressure(x, a, lam, h, E_star):
-    """Westergaard pressure [pressure]:
-    2 p* cos(pi x/lam) sqrt(sin^2(pi a/lam) - sin^2(pi x/lam)) in |x| < a, 0 outside."""
+    """Westergaard pressure 2 p* cos(pi x/lam) sqrt(sin^2(pi a/lam) - sin^2(pi x/lam)) in |x| < a [pressure]."""
     th, tb = np.pi * _fold(x, lam) / lam, np.pi * a / lam
     d = np.sin(tb - th) * np.sin(tb + th)                    # sin^2 tb - sin^2 th
     return np.where(th < tb, 2.0 * full_contact_pressure(lam, h, E_star) * np.cos(th)
@@ -78,8 +71,7 @@ def westergaard_pressure(x, a, lam, h, E_star):
 
 def punch_pressure(x, a, lam):
     """Koiter's periodic flat-punch pressure of unit mean [-] [K59]:
-    cos(pi x/lam) / sqrt(sin^2(pi a/lam) - sin^2(pi x/lam)) in |x| < a, 0 outside
-    (its mean over a period is 1; the contact stays flat)."""
+    cos(pi x/lam) / sqrt(sin^2(pi a/lam) - sin^2(pi x/lam)) in |x| < a, 0 outside."""
     th, tb = np.pi * _fold(x, lam) / lam, np.pi * a / lam
     d = np.sin(tb - th) * np.sin(tb + th)
     inside = th < tb
@@ -87,10 +79,8 @@ def punch_pressure(x, a, lam):
 
 
 def punch_compliance(a, lam, E_star):
-    """Mean-gap change per unit mean pressure of the periodic flat punch of
-    half-width a: C = -(2 lam/(pi E*)) ln sin(pi a/lam) [length/pressure];
-    -dC/da = (2/E*) cot(pi a/lam), and G = (lam/4) sigma^2 |dC/da| =
-    K^2/(2 E*) with K = sigma sqrt(lam cot psi) (Irwin-Kies, per crack tip)."""
+    """Mean-gap change per unit mean pressure of the periodic flat punch of half-width a [length/pressure]:
+    C = -(2 lam/(pi E*)) ln sin(pi a/lam); G = (lam/4) sigma^2 |dC/da| = K^2/(2 E*) (Irwin-Kies, per tip)."""
     return -2.0 * lam / (np.pi * E_star) * np.log(np.sin(_psi(a, lam)))
 
 
@@ -103,9 +93,8 @@ def jkr_mean_pressure(a, lam, h, E_star, w):
 
 
 def jkr_stress_intensity(a, pbar, lam, h, E_star):
-    """Mode-I stress intensity at the contact edge for half-width a and mean
-    pressure pbar: K = (p* sin^2 psi - pbar) sqrt(lam cot psi) [pressure*length^0.5]
-    (Westergaard + Koiter superposition, docs/models.md; [CM04] symmetric case)."""
+    """Mode-I stress intensity K = (p* sin^2 psi - pbar) sqrt(lam cot psi) at the contact edge
+    [pressure*length^0.5] (Westergaard + Koiter superposition, docs/models.md; [CM04] symmetric case)."""
     psi = _psi(a, lam)
     return ((full_contact_pressure(lam, h, E_star) * np.sin(psi) ** 2 - pbar)
             * np.sqrt(lam / np.tan(psi)))
@@ -119,18 +108,15 @@ def jkr_mean_gap(a, lam, h, E_star, w):
 
 
 def jkr_pressure(x, a, pbar, lam, h, E_star):
-    """Contact pressure [pressure] for half-width a and mean pressure pbar (any
-    pbar; the JKR equilibrium is pbar = jkr_mean_pressure(a, ...)):
-    westergaard_pressure + (pbar - p* sin^2 psi) * punch_pressure, i.e.
-    Westergaard plus Koiter's punch carrying pbar - pbar_W [J95]."""
+    """Contact pressure [pressure] for half-width a and any mean pressure pbar: Westergaard plus Koiter's punch
+    carrying pbar - pbar_W [J95] (the JKR equilibrium is pbar = jkr_mean_pressure(a, ...))."""
     pw = westergaard_mean_pressure(a, lam, h, E_star)
     return westergaard_pressure(x, a, lam, h, E_star) + (pbar - pw) * punch_pressure(x, a, lam)
 
 
 def jkr_stationary_points(alpha):
-    """psi = pi a/lam of the local minimum and maximum of pbar(a) [-]:
-    the two roots of alpha = 4 sin^(3/2) psi cos^(5/2) psi (NaN, NaN when
-    alpha >= ALPHA_FOLD, where pbar(a) decreases monotonically)."""
+    """psi = pi a/lam of the local minimum and maximum of pbar(a): the roots of alpha = 4 sin^(3/2) psi
+    cos^(5/2) psi (NaN, NaN when alpha >= ALPHA_FOLD, where pbar(a) decreases monotonically)."""
     if alpha <= 0:
         return 0.0, np.pi / 2
     if alpha >= ALPHA_FOLD:
@@ -148,36 +134,23 @@ def _jkr_stationary_state(which, lam, h, E_star, w):
 
 
 def jkr_pulloff_load_control(lam, h, E_star, w):
-    """Load-control pull-off from a partial-contact state: the local minimum of
-    pbar(a) [J95].
+    """Load-control pull-off from partial contact, the local minimum of pbar(a) [J95]: (pbar [pressure], a [length]).
 
-    Returns
-    -------
-    pbar [pressure], a [length] : float
-        NaN for alpha >= ALPHA_FOLD (no local minimum).  For alpha -> 0,
-        pbar -> -3 p* (alpha/4)^(4/3) (isolated JKR cylinders of radius
-        lam^2/(4 pi^2 h): per unit length -(3/4)(4 pi E* R w^2)^(1/3)).
-        For alpha >= ALPHA_SPONTANEOUS the surfaces are in full contact at
-        zero load and the ideal JKR wave has no finite pull-off from there.
+    NaN for alpha >= ALPHA_FOLD (no local minimum). For alpha -> 0, pbar -> -3 p* (alpha/4)^(4/3) (isolated
+    JKR cylinders); for alpha >= ALPHA_SPONTANEOUS the full contact reached at zero load has no finite pull-off.
     """
     return _jkr_stationary_state(0, lam, h, E_star, w)
 
 
 def jkr_jump_in(lam, h, E_star, w):
-    """Local maximum of pbar(a): above it (load control) the surfaces jump into
-    full contact [J95].  Returns (pbar [pressure], a [length]); pbar <= 0 iff
-    alpha >= ALPHA_SPONTANEOUS."""
+    """Local maximum (pbar [pressure], a [length]) of pbar(a), above which the surfaces jump into full contact
+    [J95]; pbar <= 0 iff alpha >= ALPHA_SPONTANEOUS."""
     return _jkr_stationary_state(1, lam, h, E_star, w)
 
 
 def jkr_pulloff_displacement_control(lam, h, E_star, w):
-    """Separation under mean-gap control: the maximum of gbar(a) on the branch
-    below the local maximum of pbar (d gbar/da = 0), where the contacts snap off.
-
-    Returns
-    -------
-    pbar [pressure], a [length], gbar [length] : float
-    """
+    """Separation under mean-gap control, the maximum of gbar(a) below the local maximum of pbar:
+    (pbar [pressure], a [length], gbar [length])."""
     alpha = johnson_alpha(lam, h, E_star, w)
     top = jkr_stationary_points(alpha)[1] if alpha < ALPHA_FOLD else np.pi / 2 - 1e-9
     f = lambda p: -jkr_mean_gap(p * lam / np.pi, lam, h, E_star, w)
@@ -191,8 +164,7 @@ def jkr_pulloff_displacement_control(lam, h, E_star, w):
 
 # ------------------------------------------------------------ Maugis-Dugdale
 def _tanh_sinh(n=40, step=None):
-    """Tanh-sinh rule on [0, 1]: distances of the nodes from 0 and from 1 (both
-    accurate near the ends) and weights."""
+    """Tanh-sinh rule on [0, 1]: distances of the nodes from 0 and from 1 (accurate near the ends), weights."""
     step = step or 3.3 / n
     k = np.arange(-n, n + 1) * step
     u = 0.5 * np.pi * np.sinh(k)
@@ -205,8 +177,7 @@ def _tanh_sinh(n=40, step=None):
 
 
 def _beta_grid(n):
-    """Interior grid of (0, pi/2), geometric near 0 (states close to JKR have
-    beta ~ (pi/(2 sigma0)) (pbar_W - pbar) << 1)."""
+    """Interior grid of (0, pi/2), geometric near 0 (where the states close to JKR are)."""
     g = np.concatenate([np.geomspace(1e-10, 2e-2, n // 4), np.linspace(0.0, np.pi / 2, n + 1)[1:-1]])
     return np.unique(g)
 
@@ -219,16 +190,7 @@ class WavyMaugisDugdale:
     (MD1) pbar = p* sin^2(pi a/lam) - (2 sigma0/pi) beta, (MD2) the gap at x = c is h0; beta = pi/2 is the
     saturated state (c = lam/2). Derivation, checks and the solution set: docs/models.md.
 
-    Parameters
-    ----------
-    lam, h : float
-        Wavelength and amplitude [length].
-    E_star, sigma0 : float
-        Composite modulus and Dugdale stress [pressure].
-    w : float
-        Work of adhesion [energy/area]; h0 = w / sigma0.
-    n_quad : int
-        Half-size of the tanh-sinh rule for the two integrals.
+    ``n_quad`` is the half-size of the tanh-sinh rule for the two integrals.
     """
 
     def __init__(self, lam, h, E_star, w, sigma0, n_quad=40):
@@ -242,8 +204,7 @@ class WavyMaugisDugdale:
 
     # geometry ----------------------------------------------------------------
     def cohesive_end(self, a, beta):
-        """Outer end c of the Dugdale zone [length]: sin^2(pi c/lam) =
-        b^2 + (1 - b^2) sin^2 beta."""
+        """Outer end c of the Dugdale zone [length]: sin^2(pi c/lam) = b^2 + (1 - b^2) sin^2 beta."""
         b2 = np.sin(np.pi * a / self.lam) ** 2
         return self.lam / np.pi * np.arcsin(np.sqrt(b2 + (1.0 - b2) * np.sin(beta) ** 2))
 
@@ -319,8 +280,7 @@ class WavyMaugisDugdale:
                                          xtol=1e-15, rtol=1e-14)
 
     def a_of_beta(self, beta):
-        """Contact half-width a(beta) [length] of the unsaturated state (MD2);
-        NaN if the gap at a = 0 is below h0 (no state with this beta)."""
+        """Contact half-width a(beta) [length] of the unsaturated state (MD2); NaN if there is none."""
         F = lambda a: self.gap_at_cohesive_end(a, beta) - self.h0
         if F(0.0) < 0:
             return np.nan
@@ -329,8 +289,7 @@ class WavyMaugisDugdale:
         return brentq(F, 0.0, 0.5 * self.lam * (1 - 1e-12), xtol=1e-15 * self.lam, rtol=1e-14)
 
     def beta_intervals(self, n=400):
-        """Intervals [beta_1, beta_2] of beta with an unsaturated state (where the
-        gap at a = 0, g(c)|_{a=0} - h0, is >= 0), endpoints refined by brentq."""
+        """Intervals [beta_1, beta_2] of beta with an unsaturated state (the gap at a = 0 is >= h0)."""
         F = lambda bt: self.gap_at_cohesive_end(0.0, bt) - self.h0
         grid = _beta_grid(n)
         v = np.array([F(bt) for bt in grid])
@@ -346,8 +305,7 @@ class WavyMaugisDugdale:
         return out
 
     def states_at(self, a, n=400):
-        """All beta in (0, pi/2] of equilibrium states with contact half-width a,
-        in increasing order (pi/2 = saturated, if a >= a_saturation)."""
+        """All beta in (0, pi/2] of equilibrium states with half-width a, increasing (pi/2 = saturated)."""
         F = lambda bt: self.gap_at_cohesive_end(a, bt) - self.h0
         grid = _beta_grid(n)
         v = np.array([F(bt) for bt in grid])
@@ -363,14 +321,8 @@ class WavyMaugisDugdale:
                 "pbar": float(self.mean_pressure(a, beta)), "gbar": self.mean_gap(a, beta)}
 
     def curve(self, n=200):
-        """The contact solution set: unsaturated branches (sampled in beta), then
-        the saturated branch a in [a_saturation, lam/2].
-
-        Returns
-        -------
-        dict of ndarray
-            "a", "c", "beta", "pbar", "gbar" and "saturated" (bool).
-        """
+        """The contact solution set: unsaturated branches (sampled in beta), then the saturated branch a in
+        [a_saturation, lam/2], as arrays "a", "c", "beta", "pbar", "gbar" and "saturated" (bool)."""
         rows = []
         for b1, b2 in self.beta_intervals():
             t = 0.5 - 0.5 * np.cos(np.linspace(0.0, np.pi, n))
@@ -392,8 +344,7 @@ class WavyMaugisDugdale:
         return {k: np.array(v) for k, v in out.items()}
 
     def _branch_minimum(self, b1, b2, first):
-        """Minimum of pbar(beta) = pbar(a(beta), beta) on [b1, b2): the first local
-        minimum from b1 (first=True) or the smallest value."""
+        """Minimum of pbar(a(beta), beta) on [b1, b2): the first local one (first=True) or the smallest."""
         hi = min(b2, np.pi / 2 * (1 - 1e-9))
         f = lambda bt: float(self.mean_pressure(self.a_of_beta(bt), bt))
         grid = b1 + (hi - b1) * (0.5 - 0.5 * np.cos(np.linspace(0.0, np.pi, 161)))
@@ -410,15 +361,9 @@ class WavyMaugisDugdale:
         return float(v[i]), float(grid[i])
 
     def pulloff(self):
-        """Load-control pull-off from partial contact: the first local minimum of
-        pbar along the unsaturated branch that starts at a = 0 (the counterpart of
-        :func:`jkr_pulloff_load_control`; the a -> 0 end itself if pbar rises from
-        there) [pressure].  NaN if there is no unsaturated branch.
-
-        Returns
-        -------
-        pbar [pressure], a [length], beta : float
-        """
+        """Load-control pull-off from partial contact, the first local minimum of pbar along the unsaturated
+        branch from a = 0 (cf. :func:`jkr_pulloff_load_control`): (pbar [pressure], a [length], beta); NaN if
+        there is no unsaturated branch."""
         iv = self.beta_intervals()
         if not iv:
             return np.nan, np.nan, np.nan
@@ -426,15 +371,8 @@ class WavyMaugisDugdale:
         return p, self.a_of_beta(bt), bt
 
     def pulloff_global(self):
-        """Minimum mean pressure over all contact states [pressure]: the
-        load-control pull-off when unloading from full contact (then the saturated
-        branch is followed down to a_saturation).  Always >= -sigma0, and = -sigma0
-        when h0 >= 2h (saturated states down to a = 0 and beyond, without contact).
-
-        Returns
-        -------
-        pbar [pressure], a [length], beta : float
-        """
+        """Minimum mean pressure over all states, the load-control pull-off from full contact: (pbar [pressure],
+        a [length], beta); >= -sigma0, = -sigma0 when h0 >= 2h."""
         a_sat = self.a_saturation()
         best = (float(self.mean_pressure(a_sat, np.pi / 2)), a_sat, np.pi / 2)
         for b1, b2 in self.beta_intervals():
