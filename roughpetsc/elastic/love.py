@@ -1,11 +1,7 @@
 """Love's influence coefficients (3.31) of the non-periodic half-space, applied by FFT on a padded grid.
 
-A uniform pressure on one rectangular element ``dx x dy`` of the surface of an elastic half-space
-(no periodic images) displaces the surface point at offsets ``(R, S)`` from the element's centre by
-``K(R, S) / (pi E*)`` per unit pressure, (3.30)-(3.31) of the dissertation (Love 1929). The sum (3.30)
-over an ``n0 x n1`` grid is a linear (not circular) convolution; embedded in a ``2 n0 x 2 n1``
-circulant (zero padding of the pressure, the kernel laid out with its negative offsets wrapped: the
-Hockney / DC-FFT construction), it becomes one real FFT pair of twice the size in each direction.
+The sum (3.30) over an ``n0 x n1`` grid is a linear convolution; embedded in a ``2 n0 x 2 n1`` circulant
+(Hockney / DC-FFT), it becomes one real FFT pair of twice the size in each direction.
 """
 
 import numpy as np
@@ -19,9 +15,7 @@ from .westergaard import periodic_transform, stiffness_symbol
 def _primitive(a, b):
     """``a asinh(b / a) + b asinh(a / b)``, the double integral of 1/r; 0 where a factor is 0.
 
-    The form with ``asinh`` replaces (3.31)'s logarithms of ratios: it is the same function
-    (``ln(y + sqrt(x^2 + y^2)) = asinh(y / |x|) + ln|x|``, the ``ln|x|`` cancelling in each ratio)
-    but does not lose digits to cancellation far from the element.
+    The same function as (3.31)'s logarithms of ratios, without their cancellation far from the element.
     """
     a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -31,22 +25,8 @@ def _primitive(a, b):
 
 
 def influence(offset_x, offset_y, dx, dy):
-    """Love's coefficient ``K_rs`` of (3.31) (length units) for offsets from an element's centre.
-
-    Parameters
-    ----------
-    offset_x, offset_y : array_like
-        Offsets ``R``, ``S`` of the field point from the loaded element's centre (length units,
-        any sign; the coefficient is even in each).
-    dx, dy : float
-        Element sizes.
-
-    Returns
-    -------
-    ndarray
-        ``K`` such that the normal surface displacement is ``K p / (pi E*)`` for a uniform pressure
-        ``p`` on the element: the integral of ``1 / r`` over the element.
-    """
+    """Love's coefficient ``K_rs`` of (3.31) (length units) at offsets ``(R, S)`` from the centre of a
+    ``dx x dy`` element: the surface displacement is ``K p / (pi E*)`` for a uniform pressure p on it."""
     r = np.abs(np.asarray(offset_x, float))
     s = np.abs(np.asarray(offset_y, float))
     hx, hy = 0.5 * dx, 0.5 * dy
@@ -57,9 +37,7 @@ def influence(offset_x, offset_y, dx, dy):
 def circulant_kernel(n0, n1, dy, dx):
     """The ``(2 n0, 2 n1)`` circulant embedding of the influence coefficients of an ``n0 x n1`` grid.
 
-    Index ``(i, j)`` holds the coefficient of the offset ``(i, j)`` rows/columns for ``i < n0`` and of
-    ``i - 2 n0`` for ``i > n0`` (likewise ``j``); the offset ``n0`` (``n1``) never occurs between two
-    nodes of the grid and is left 0.
+    Negative offsets wrapped to ``i + 2 n0``; the offset ``n0`` (``n1``), which never occurs, is 0.
     """
     rows = np.arange(2 * n0)
     cols = np.arange(2 * n1)
@@ -72,11 +50,9 @@ def circulant_kernel(n0, n1, dy, dx):
 
 
 def padded_symbol(n0, n1, dy, dx, E_star):
-    """The real ``rfft2`` symbol of the free-boundary compliance on the padded grid.
+    """The real ``rfft2`` symbol of the free-boundary compliance (3.30) on the padded grid, 1 / (4 n0 n1) folded in.
 
-    ``w = crop(irfft2(symbol * rfft2(pad(p))))`` is (3.30) with the coefficients (3.31): the kernel is
-    even in both offsets, so its transform is real (the imaginary part is round-off and dropped).
-    The ``1 / (4 n0 n1)`` of the unnormalised FFT pair is folded in.
+    The kernel is even in both offsets, so its transform is real.
     """
     kernel = circulant_kernel(n0, n1, dy, dx) / (np.pi * E_star)
     return np.fft.rfft2(kernel).real / (4 * n0 * n1)
@@ -97,15 +73,8 @@ def direct_displacement(pressure, dy, dx, E_star):
 class FreeBoundary(FilterOperator):
     """The compliance of an isolated half-space, (3.30)-(3.31), as the operator of a contact problem.
 
-    The counterpart of :class:`roughpetsc.westergaard.Westergaard` for a free (non-periodic)
-    boundary: the same Vec layout, ``displacement``, ``stiffness`` and ``mat``, applied through
-    :class:`PaddedTransform` (one FFT pair of the padded grid per application, four times the
-    points of the periodic one). The displacement has no zero-mean property: the mean gap is not
-    the rigid separation.
-
-    The preconditioner's ``stiffness`` is the periodic stiffness ``pi E* max(|k|, 1 / 2L)`` of the
-    doubled cell applied to the zero-padded field and cropped: the inverse of the compliance of a
-    cell twice as large, which the free compliance approaches away from the edges of the loaded region.
+    As :class:`Westergaard`, through :class:`PaddedTransform`; the mean gap is not the rigid separation.
+    ``stiffness`` is the periodic ``pi E* max(|k|, 1 / 2L)`` of the doubled cell on the zero-padded field.
     """
 
     boundary = "free"
@@ -132,11 +101,7 @@ class FreeBoundary(FilterOperator):
         return self._diagonal
 
     def pressure_surface(self, heights, out):
-        """``out = F^-1[pi E* |k| F[heights]]`` on the periodic cell: p_c of (2.47), a statistic of the surface.
-
-        p* is measured with it on either boundary. The free boundary has no FFT pair of the cell itself: one
-        is made for this call and released.
-        """
+        """``out = F^-1[pi E* |k| F[heights]]`` on the periodic cell: p_c of (2.47), by a transient FFT pair."""
         transform = periodic_transform(self.grid, self.comm, self.threads, self.effort)
         try:
             symbol = stiffness_symbol(self.grid, self.E_star, transform.spectral_slice)

@@ -4,8 +4,7 @@ import numpy as np
 from petsc4py import PETSc
 
 
-# PETSc log events (-log_view, prefix RP for roughpetsc): the operator applications by kind
-# (RPCompliance, RPStiffness), and every FFT pair (r2c, symbol product, c2r) whatever asked for it.
+# PETSc log events (-log_view): the operator applications by kind, and every FFT pair.
 log_event = PETSc.Log.EventDecorator
 
 
@@ -17,12 +16,9 @@ def wavenumber_modulus(grid, rows=slice(None), cols=slice(None)):
 class FilterOperator:
     """A compliance applied as a real Fourier filter: the Vec layout, the shell Mat, the counts.
 
-    What the periodic (:class:`Westergaard`) and the free-boundary
-    (:class:`roughpetsc.love.FreeBoundary`) compliances share. A subclass sets ``transform`` (an
-    object with ``filter(source, target, symbol)``, ``local_rows`` and ``spectral_slice``), the
-    symbols ``compliance_symbol`` and ``preconditioner_symbol`` (real, one value per float of the
-    local spectral block, normalisation folded in) and the ``diagonal`` of the compliance matrix,
-    then calls :meth:`_set_layout`.
+    A subclass sets ``transform`` (with ``filter(source, target, symbol)``, ``local_rows``,
+    ``spectral_slice``), ``compliance_symbol`` and ``preconditioner_symbol`` (per float, normalised) and
+    ``diagonal``, then calls :meth:`_set_layout`.
 
     Attributes
     ----------
@@ -40,14 +36,7 @@ class FilterOperator:
         self.applications = 0
 
     def vec(self):
-        """A new distributed Vec laid out like the grid (rows owned by this rank).
-
-        The local size is given explicitly (this rank's rows times ``n1``), so
-        PETSc's ownership range is exactly ``local_rows`` however unevenly the
-        rows are shared (PETSC_DECIDE would split the ``n0 n1`` nodes, not rows).
-        Its memory is SIMD-aligned, so that the FFTW plans (serial or slab) run
-        on it in place (no copy per application).
-        """
+        """A new distributed Vec of this rank's rows (``local_rows``), SIMD-aligned for in-place FFTW plans."""
         import pyfftw
 
         n_local = self.local_shape[0] * self.local_shape[1]
@@ -75,10 +64,7 @@ class FilterOperator:
 
     @log_event("RPStiffness")
     def stiffness(self, source, target):
-        """``target = S source`` on local ``(rows, n1)`` arrays: the preconditioner's approximate inverse of K.
-
-        Counts as an application. See the subclass for what ``S`` is.
-        """
+        """``target = S source`` on local ``(rows, n1)`` arrays: the preconditioner's approximate inverse of K."""
         self.applications += 1
         self._filter(source, target, self.preconditioner_symbol)
 
@@ -107,9 +93,7 @@ def per_float(symbol):
 class ShellContext:
     """The MATPYTHON context of :meth:`FilterOperator.mat`: K + perturbation I.
 
-    ``perturbation`` is TAO's Hessian shift: the BNK family (BNLS, BNTR, BNTL)
-    calls MatShift when a Newton step fails to descend, and expects the next
-    Hessian evaluation to start afresh (the owner sets ``perturbation`` back to 0).
+    ``perturbation`` is the BNK family's MatShift; the owner resets it at each Hessian evaluation.
     """
 
     def __init__(self, operator):

@@ -23,10 +23,9 @@ COMPONENTS = ("xx", "yy", "zz", "xy", "yz", "xz")
 
 @njit(cache=True)
 def depth_decay(k0, k1, depth, kz, decay):
-    """``kz = 2 pi |k| z`` and ``decay = exp(-kz)`` on the half spectrum of wavenumbers ``(k0, k1)``.
+    """``kz = 2 pi |k| z`` and ``decay = exp(-kz)`` on the half spectrum of ``(k0, k1)`` (cycles per length).
 
-    ``k0`` (rows, ``y``, as :func:`numpy.fft.fftfreq` orders them) and ``k1`` (columns, ``x``) in cycles per
-    length; the rows of ``ky`` and ``-ky`` share their exponentials.
+    The rows of ``ky`` and ``-ky`` share their exponentials.
     """
     rows, columns = kz.shape
     for row in range(rows):
@@ -80,10 +79,7 @@ def uniform_state(mean_pressure, nu):
 
 
 def von_mises(s):
-    """The von Mises equivalent stress of the components in dict ``s`` (arrays of one shape).
-
-    ``sqrt(3 (sum of the squared normal differences / 6 + sum of the squared shears))``.
-    """
+    """The von Mises equivalent stress of the components in dict ``s`` (arrays of one shape)."""
     return _von_mises_and_where_largest(s)[0]
 
 
@@ -97,8 +93,7 @@ def _von_mises_and_where_largest(s):
 
 @njit(cache=True, fastmath={"reassoc"})
 def _von_mises_and_maximum(xx, yy, zz, xy, yz, xz, out):
-    """``out`` = the von Mises stress of the flat components, in one sweep; returns the flat index of its
-    maximum (the first one, as ``numpy.argmax``)."""
+    """``out`` = the von Mises stress of the flat components; returns the index of its first maximum."""
     largest = -1.0
     where = 0
     for i in range(out.size):
@@ -144,11 +139,7 @@ def check_poisson(nu):
 
 
 def fft_pair(shape, effort):
-    """FFTW plans ``real -> spectrum`` and back on aligned arrays of ``shape`` (the backward destroys its input).
-
-    Plans of the operator's shape and effort are already in FFTW's wisdom after a solve, so these cost
-    no planning then.
-    """
+    """FFTW plans ``real -> spectrum`` and back on aligned arrays of ``shape`` (the backward destroys its input)."""
     import pyfftw
 
     real = pyfftw.empty_aligned(shape, dtype="float64")
@@ -161,7 +152,7 @@ def fft_pair(shape, effort):
 
 
 def _inverse_into_new_array(backward, spectrum):
-    """The backward transform of ``spectrum`` (destroyed) written straight into a new aligned array."""
+    """The backward transform of ``spectrum`` (destroyed) into a new aligned array."""
     import pyfftw
 
     out = pyfftw.empty_aligned(backward.output_shape, dtype="float64")
@@ -195,13 +186,7 @@ def periodic_stresses(pressure, lengths, depths, nu, effort="FFTW_MEASURE"):
     Yields
     ------
     DepthStresses
-        One per depth, in the order given, each in arrays of its own.
-
-    Notes
-    -----
-    One forward transform serves every depth, then one inverse per component and depth: six half-size
-    (real) inverse transforms per depth are the floor of the method (about two operator applications,
-    measured by ``studies/free_hardness.py``).
+        One per depth, in the order given.
     """
     depths = check_depths(depths)
     check_poisson(nu)
@@ -224,12 +209,10 @@ def periodic_stresses(pressure, lengths, depths, nu, effort="FFTW_MEASURE"):
 
 
 def _corner_terms(X, Y, z, nu):
-    """The six stresses of a unit pressure on the quarter plane beyond a corner at offsets (X, Y), depth z.
+    """The six stresses of a unit pressure on the quarter plane beyond a corner at offsets (X, Y), depth z >= 0.
 
-    From Love's potentials of a uniform normal pressure (Johnson, Contact Mechanics, 1985, section 3.2):
-    ``psi = int 1/rho`` and ``psi1 = int ln(rho + z)`` over the loaded area, whose derivatives over a
-    rectangle are sums over its corners of the elementary terms below (each a primitive in X and Y of
-    the point-load integrand). ``z >= 0``; X and Y are never 0 (corners are half a node off the nodes).
+    Corner terms of Love's potentials ``psi = int 1/rho``, ``psi1 = int ln(rho + z)`` (Johnson, Contact
+    Mechanics, 1985, section 3.2); X and Y are never 0.
     """
     rho = np.sqrt(X * X + Y * Y + z * z)
     xz2, yz2 = X * X + z * z, Y * Y + z * z
@@ -257,9 +240,7 @@ def _corner_terms(X, Y, z, nu):
 def element_influence(offset_x, offset_y, dx, dy, depth, nu):
     """Stresses at depth under the offsets from the centre of one element carrying unit pressure.
 
-    The corner sum of :func:`_corner_terms` over the element ``dx x dy``: the free-boundary
-    counterpart of (3.31) for the stresses. Offsets are never on an element edge for node-centred
-    field points (``|offset| = (i + 1/2) dx`` at the corners).
+    The corner sum of :func:`_corner_terms` over the element ``dx x dy``, the counterpart of (3.31).
     """
     hx, hy = 0.5 * dx, 0.5 * dy
     total = None
@@ -281,15 +262,10 @@ PARITY = {"xx": (1.0, 1.0), "yy": (1.0, 1.0), "zz": (1.0, 1.0), "xy": (-1.0, -1.
 
 def padded_influence(n0, n1, spacing, depth, nu, out=None):
     """Yield ``(component, kernel)``: :func:`element_influence` at every offset between two nodes of an
-    ``n0 x n1`` grid, in the wrapped layout of the zero-padded ``2 n0 x 2 n1`` FFT (offset i at index
-    i mod 2 n0; the offsets of n0 rows and n1 columns, which never occur, hold 0). Each kernel is
-    written into ``out`` if given (so it is spent by the next), else into an array of its own.
+    ``n0 x n1`` grid, in the wrapped layout of the zero-padded ``2 n0 x 2 n1`` FFT, written into ``out`` if given.
 
-    Neighbouring elements share corners, so the corner terms are evaluated once on the lattice of corner
-    positions and each element's sum is a difference of the lattice; and each influence has a parity in
-    each offset (:data:`PARITY`), so only the quadrant of offsets >= 0 is evaluated, on the
-    (n0 + 1) x (n1 + 1) corners at -1/2, 1/2, ..., n - 1/2 spacings: a sixteenth of the transcendental
-    functions of a sum over each element's own four corners.
+    The corner terms are evaluated once on the lattice of corners of the quadrant of offsets >= 0, the rest
+    follows by :data:`PARITY`: a sixteenth of the transcendental functions of a sum per element.
     """
     dy, dx = spacing
     corner_y = ((np.arange(n0 + 1) - 0.5) * dy)[:, None]
@@ -312,9 +288,7 @@ def padded_influence(n0, n1, spacing, depth, nu, out=None):
 def free_stresses(pressure, spacing, depths, nu, effort="FFTW_MEASURE"):
     """Stresses at each depth below a pressure on an isolated (non-periodic) half-space.
 
-    The free-boundary counterpart of :func:`periodic_stresses`: the influence of every element
-    (:func:`element_influence`, exact for piecewise-constant pressure) convolved with the pressure by
-    FFT on the zero-padded ``2 n0 x 2 n1`` grid, like the displacements of :mod:`roughpetsc.love`.
+    :func:`element_influence` convolved with the pressure by FFT on the zero-padded ``2 n0 x 2 n1`` grid.
 
     Parameters
     ----------
@@ -328,11 +302,6 @@ def free_stresses(pressure, spacing, depths, nu, effort="FFTW_MEASURE"):
     Yields
     ------
     DepthStresses
-
-    Notes
-    -----
-    Per component and depth: the kernel on a quarter of the offsets, one padded forward transform of it
-    and one padded inverse of the product; twelve padded transforms per depth.
     """
     depths = check_depths(depths)
     check_poisson(nu)

@@ -1,11 +1,7 @@
 """The periodic Westergaard operator (3.33) as a matrix-free PETSc shell Mat.
 
-``w = F^-1[ F[p] / (pi E* |k|) ]`` for k != 0; the k = 0 mode carries no
-displacement (the mean pressure only moves the body rigidly; docs/conventions.md),
-so the mean of ``w`` is zero and the mean gap equals the rigid separation (3.38).
-
-One rank: a direct 2-D FFTW plan in place on the Vecs' memory; several ranks: the slab transform of
-:mod:`roughpetsc.slab` (docs/runtime.md).
+``w = F^-1[ F[p] / (pi E* |k|) ]`` for k != 0; the k = 0 mode carries no displacement (docs/conventions.md),
+so the mean gap equals the rigid separation (3.38).
 """
 
 import numpy as np
@@ -45,16 +41,10 @@ class Westergaard(FilterOperator):
     threads : int
         FFTW threads of the one-rank plan.
     effort : str
-        FFTW planner flag (``FFTW_ESTIMATE``, ``FFTW_MEASURE``, ``FFTW_PATIENT``).
+        FFTW planner flag.
 
-    Attributes
-    ----------
-    transform : SerialTransform or roughpetsc.slab.SlabTransform
-        The FFT pair: a 2-D FFTW plan on one rank, the slab transform on several.
-
-    The preconditioner's ``stiffness`` is ``F^-1[pi E* max(|k|, 1/L) F[source]]``: the inverse symbol
-    of the compliance, with the mean (k = 0) mode weighted like the longest wavelength 1/L instead of
-    dropped (Polonsky-Keer needs the mean under displacement control).
+    The preconditioner's ``stiffness`` is ``F^-1[pi E* max(|k|, 1/L) F[source]]``: the k = 0 mode is kept,
+    as Polonsky-Keer needs the mean under displacement control.
     """
 
     boundary = "periodic"
@@ -69,12 +59,10 @@ class Westergaard(FilterOperator):
         k = wavenumber_modulus(grid, *self.transform.spectral_slice)
         with np.errstate(divide="ignore"):
             # The 1/(n0 n1) of the unnormalised FFT pair is folded into the symbols.
-            compliance = np.where(k > 0, 1.0 / (np.pi * self.E_star * k), 0.0) / grid.size
+            self.compliance_symbol = per_float(np.where(k > 0, 1.0 / (np.pi * self.E_star * k), 0.0) / grid.size)
         longest = 1.0 / max(grid.l0, grid.l1)
-        preconditioner = np.pi * self.E_star * np.maximum(k, longest) / grid.size
-        self.compliance_symbol = per_float(compliance)
         self._stiffness = stiffness_symbol(grid, self.E_star, self.transform.spectral_slice)
-        self.preconditioner_symbol = per_float(preconditioner)
+        self.preconditioner_symbol = per_float(np.pi * self.E_star * np.maximum(k, longest) / grid.size)
 
     @property
     def diagonal(self):
@@ -87,11 +75,7 @@ class Westergaard(FilterOperator):
 
     @log_event("RPStiffness")
     def elastic_pressure(self, displacement, out):
-        """``out = F^-1[pi E* |k| F[displacement]]``: the pressure less its mean that makes ``displacement``.
-
-        The exact inverse of the compliance on the zero-mean fields (the adhesive gap formulation's
-        Hessian); counts as an application.
-        """
+        """``out = F^-1[pi E* |k| F[displacement]]``: the pressure less its mean that makes ``displacement``."""
         self.applications += 1
         self._filter(self.local(displacement, readonly=True), self.local(out), self._stiffness)
 

@@ -23,9 +23,7 @@ def _overlaps(starts_a, counts_a, starts_b, counts_b):
 class RowExchange:
     """Moves rows between two row splits of the same array over MPI (one ``Alltoallv`` each way).
 
-    ``forward`` sends this rank's rows of split ``a`` (the grid's ``n0`` rows) into its rows of
-    split ``b`` (the first ``n0`` of the padded grid's ``2 n0`` rows); ``backward`` the reverse.
-    Only ``columns`` columns travel.
+    ``forward``: the grid's split ``a`` into the padded grid's split ``b``; ``backward`` the reverse.
     """
 
     def __init__(self, comm, split_a, split_b, columns):
@@ -67,10 +65,7 @@ class RowExchange:
 class PrunedPaddedTransform:
     """The zero-padded ``2 n0 x 2 n1`` FFT pair on one rank, pruned to the quarter that holds the field.
 
-    The field occupies rows and columns ``[0, n0) x [0, n1)`` of the padded grid and only that block
-    of the result is kept, so the row transforms (along axis 1) run on the ``n0`` rows that carry data,
-    forward and backward, instead of all ``2 n0``: about a quarter less work than the full 2-D plan,
-    with the same result. Four pyFFTW plans made once (real rows, complex columns, each way).
+    The row transforms run on the ``n0`` rows that carry data: about a quarter less work than the full plan.
     """
 
     def __init__(self, padded, threads, effort):
@@ -108,10 +103,8 @@ class PrunedPaddedTransform:
 class PaddedTransform:
     """Linear convolution of a grid's field by FFT on the zero-padded ``2 n0 x 2 n1`` grid.
 
-    The same ``filter(source, target, symbol)`` contract as the periodic transforms (real symbol
-    per float of the local spectral block of the padded grid, normalisation folded in), on the
-    grid's own local rows: the padding, and on several ranks the move of rows between the grid's
-    split and the padded grid's split, happen inside.
+    The ``filter`` contract of the periodic transforms, on the grid's own local rows (symbol per float of
+    the padded grid's local spectral block); padding and the exchange of rows happen inside.
     """
 
     def __init__(self, grid, comm, threads, effort):

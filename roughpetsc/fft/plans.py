@@ -67,8 +67,7 @@ def wisdom_path(option_value):
 def check_wisdom_path(option_value, option):
     """Refuse, naming ``-option``, a wisdom file given in a folder that does not exist, or a folder.
 
-    The default cache's folder is created when it is first written; a path given by hand that cannot
-    be used would otherwise be skipped without a word, and every run would measure its plans again.
+    Such a path would otherwise be skipped silently, and every run would measure its plans again.
     """
     value = (option_value or "").strip()
     if not value or value.lower() == "none":
@@ -91,20 +90,10 @@ def encode_wisdom(wisdom):
 
 @contextmanager
 def remembered_plans(comm, path, effort):
-    """Plans made inside the block come from (and go to) the wisdom file ``path``.
+    """Plans made inside the block come from (and go to) the wisdom file ``path`` (None: no file).
 
-    Rank 0 reads the file and every rank imports the same wisdom, so all later
-    runs transform alike. After the block rank 0 merges every rank's wisdom and
-    writes it back if planning added to it (atomically: a temporary file, then a
-    rename; a cache that cannot be written is skipped silently, since it only
-    saves time). Nothing happens for ESTIMATE plans or ``path`` None.
-
-    Parameters
-    ----------
-    comm : mpi4py.MPI.Comm
-    path : str or None
-    effort : str
-        The planner flag the block will use (after :func:`planner_effort`).
+    Every rank imports rank 0's wisdom; afterwards rank 0 merges every rank's and writes it back atomically
+    if planning added to it (a cache that cannot be written is skipped). Nothing happens for ESTIMATE plans.
     """
     import pyfftw
 

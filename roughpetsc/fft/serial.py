@@ -16,9 +16,7 @@ class SerialTransform:
         self._alignment = pyfftw.simd_alignment
         self.real = pyfftw.empty_aligned(shape, dtype="float64")
         self.spectrum = pyfftw.empty_aligned((shape[0], shape[1] // 2 + 1), dtype="complex128")
-        # Aligned plans run twice as fast as FFTW_UNALIGNED ones here; a Vec whose
-        # memory happens to be aligned is used in place, any other goes through
-        # self.real (a copy costs a few percent of a transform).
+        # Aligned plans run twice as fast as FFTW_UNALIGNED ones here; unaligned memory is copied via self.real.
         self._forward = pyfftw.FFTW(self.real, self.spectrum, axes=(0, 1), direction="FFTW_FORWARD",
                                     flags=(effort,), threads=threads)
         self._backward = pyfftw.FFTW(self.spectrum, self.real, axes=(0, 1), direction="FFTW_BACKWARD",
@@ -30,11 +28,7 @@ class SerialTransform:
         return array.ctypes.data % self._alignment == 0
 
     def filter(self, source, target, symbol):
-        """``target = irfft2(symbol * rfft2(source))``, unnormalised (1/N is in the symbol).
-
-        ``symbol`` is real and given per float of the complex spectrum (each
-        value twice), so the product is one contiguous real multiply.
-        """
+        """``target = irfft2(symbol * rfft2(source))``, unnormalised; ``symbol`` real, per float of the spectrum."""
         if self._aligned(source):
             self._forward.update_arrays(source, self.spectrum)
         else:

@@ -28,21 +28,12 @@ class SlabTransform:
     Parameters
     ----------
     grid : surfaces.Grid
-        At least one row per rank and one spectral column (``n1 // 2 + 1``) per rank.
+        At least one row and one spectral column (``n1 // 2 + 1``) per rank.
     comm : mpi4py.MPI.Comm
     effort : str
         FFTW planner flag.
     exchange : "auto", "shared" or "alltoall"
         ``auto`` takes ``shared`` when all ranks are on one node.
-
-    Attributes
-    ----------
-    local_rows : slice
-        Real-space rows of this rank.
-    spectral_slice : (slice, slice)
-        This rank's block of the full ``rfft2`` spectrum (all rows, a block of columns).
-    spectrum : ndarray (n0, columns) complex
-        The local spectral block (a strided view for ``shared``).
     """
 
     def __init__(self, grid, comm, effort="FFTW_MEASURE", exchange="auto"):
@@ -122,10 +113,7 @@ class SlabTransform:
         return array.ctypes.data % self._alignment == 0
 
     def forward(self, source):
-        """Unnormalised ``rfft2`` of the distributed ``(rows, n1)`` array; returns the local spectral block.
-
-        The block (``self.spectrum``) is valid until the next call.
-        """
+        """Unnormalised ``rfft2`` of the ``(rows, n1)`` array; returns the local spectral block, valid till the next."""
         if self._aligned(source) and source.flags.c_contiguous:
             self._r2c.update_arrays(source, self._rows)
         else:
@@ -153,16 +141,11 @@ class SlabTransform:
             target[...] = self.real
 
     def filter(self, source, target, symbol):
-        """``target = irfft2(symbol * rfft2(source))``, unnormalised (put 1/(n0 n1) into the symbol).
-
-        ``symbol`` is real, shape ``(n0, 2 * columns)``: one value per float of the
-        local spectral block (each value twice), as for ``westergaard.SerialTransform``.
-        """
+        """``target = irfft2(symbol * rfft2(source))``, unnormalised; ``symbol`` real, per float of the local block."""
         spectrum = self.forward(source)
         spectrum.view(np.float64).__imul__(symbol)
         self.backward(target)
 
-    # --- the Alltoallv exchange ------------------------------------------------
     def _blocks(self):
         """Per destination rank: its block of the packed buffer, ``(rows, columns)``, and its column slice."""
         rows = self._local_row_count

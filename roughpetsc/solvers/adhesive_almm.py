@@ -1,13 +1,8 @@
 """The adhesive problem as a TAO problem: ALMM with the mean-gap equality (``-tao_type almm`` with ``-adhesion``).
 
-``min Pi(g)`` over ``g >= 0`` with ``mean(g) = gbar``: TAO ALMM (the PHR augmented Lagrangian, by
-default) handles the equality and a bound-constrained subsolver (BQNLS by default,
-``-tao_almm_subsolver_tao_type``) the bounds and the non-convex energy. It is the general-purpose
-alternative to the projected CG of :mod:`roughpetsc.solvers.gap_cg`, slower and bounded below by the
-round-off floor of TAO's line searches on the energy (the non-adhesive floors are in the README).
-
-The outer iterations stop on the natural residual of :class:`~roughpetsc.contact.AdhesiveProblem`,
-computed on a fresh S g, and the error of the mean gap.
+``min Pi(g)`` over ``g >= 0`` with ``mean(g) = gbar``: ALMM (PHR) handles the equality, a bound-constrained
+subsolver (BQNLS) the bounds. Slower than :mod:`roughpetsc.solvers.gap_cg`, and bounded below by the round-off
+floor of TAO's line searches on the energy.
 """
 
 import numpy as np

@@ -1,7 +1,4 @@
-"""Load control by TAO ALMM: the QP (3.41)-(3.44) of the dissertation with the equality ``mean(p) = pbar``.
-
-Registered as ``almm`` for load control only.
-"""
+"""Load control by TAO ALMM (``almm``): the QP (3.41)-(3.44) of the dissertation with ``mean(p) = pbar``."""
 
 import numpy as np
 from petsc4py import PETSc
@@ -14,10 +11,7 @@ from .stopping import DEFAULT_MAX_IT, ConvergenceTest, History, describe_stop
 
 
 def mean_jacobian(constraint, vec, n, comm):
-    """The Jacobian of the mean of a Vec laid out like ``vec``: one dense row of 1/n, owned by rank 0.
-
-    ``constraint`` is the one-entry constraint Vec (its row is on rank 0) of an equality on the mean.
-    """
+    """The Jacobian of the mean of a Vec laid out like ``vec``: one dense row of 1/n, owned by rank 0."""
     jacobian = PETSc.Mat().createDense(((constraint.getLocalSize(), 1), (vec.getLocalSize(), n)), comm=comm)
     jacobian.setUp()
     start, end = vec.getOwnershipRange()
@@ -30,23 +24,10 @@ def mean_jacobian(constraint, vec, n, comm):
 class MeanConstrainedALMM(Backend):
     """TAO ALMM on ``unknown >= 0`` (``<= upper``) with the one equality ``mean(unknown) = target``.
 
-    What the ALMM backends of both problem kinds share: the bounds, the equality and its Jacobian, the
-    time limit inside the subsolver, the convergence test of the stopping rule on the outer iterations.
-    A subclass makes its own objects, then calls ``__init__``, and supplies :meth:`evaluate` (objective
-    and gradient), :meth:`natural_residual` (the test's ``(natural, error of the equality, fresh)``),
-    :meth:`prepare` (before a solve) and :meth:`finish` (after it; returns the Outcome's separation).
-
-    Parameters
-    ----------
-    problem :
-        The problem (its layout and comm).
-    settings : BackendSettings
-    upper : float or None
-        The upper bound of every entry (None: none).
-    hessian : petsc4py.PETSc.Mat or None
-        The Hessian TAO may use (None: none given).
-    defaults : dict
-        Working defaults of TAO options, unless given (:func:`~roughpetsc.solvers.options.default_options`).
+    The base of the ALMM backends of both problem kinds. A subclass supplies :meth:`evaluate` (objective and
+    gradient), :meth:`natural_residual` (``(natural, error of the equality, fresh)``), :meth:`prepare` and
+    :meth:`finish` (returns the Outcome's separation). ``hessian``: the Mat TAO may use; ``defaults``: working
+    defaults of TAO options.
     """
 
     name = "almm"
@@ -117,11 +98,8 @@ class MeanConstrainedALMM(Backend):
 class ALMMLoad(MeanConstrainedALMM):
     """Load control by TAO ALMM: ``min 1/2 p'Kp - p'h`` with ``p >= 0`` and ``mean(p) = pbar``.
 
-    The multiplier of the equality is the separation; it is recovered from the
-    contact set as in Polonsky-Keer. The subsolver is chosen with
+    The separation is recovered from the contact set as in Polonsky-Keer. The subsolver is chosen with
     ``-tao_almm_subsolver_tao_type`` (first-order types only in PETSc 3.18).
-
-    Parameters are those of the registry's factories (``control`` is "load", ``name`` "almm").
     """
 
     def __init__(self, problem, control, name, settings):

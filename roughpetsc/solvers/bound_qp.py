@@ -1,54 +1,8 @@
 """Every bound-constrained TAO type on the contact QP (3.41)-(3.44) of the dissertation, under both controls.
 
-Registered under every name of :data:`BOUND_TYPES` (``-tao_type blmvm``, ``Solver(problem, "load", "bqnls")``).
-Three things make them fast (studies/tao_speed.py, studies/output/tao_speed/):
-
-**Load control inside TAO, by an augmented Lagrangian on one scalar.** The load-controlled problem is
-``min 1/2 p'Kp - p'h`` over ``p >= 0`` with ``mean(p) = pbar``; the multiplier of the equality is the rigid
-separation d. Each inner solve minimises, by the TAO type,
-
-    L(p; lambda) = 1/2 p'Kp - p'h + lambda (sum p - n pbar) + c n / 2 (mean p - pbar)^2,  p >= 0,
-
-whose gradient is the gap ``K p - h + d`` at ``d = lambda + c (mean p - pbar)``: the solution is the
-displacement-controlled one at that d, with the rigid flat held by a spring of compliance c. The quadratic part is
-the same for every lambda, so the pressure stays a warm start from one inner solve to the next. The quasi-Newton
-memory does not (``-bound_al_recycle``, off): its first pair after a new lambda takes the constant shift of the
-gradient for curvature, and keeping it cost 2 to 20 % more pairs (N = 512). lambda starts at the previous load's
-separation along a load path, else at Polonsky-Keer's separation of the start (zero mean gap on its contact set).
-Between inner solves lambda moves to the root of P(d) = pbar, P the mean pressure of the displacement-controlled
-solution: first by a Newton step with the contact stiffness k = -dP/dd = 1_C' K_CC^-1 1_C / n of the first inner
-solution (:func:`contact_stiffness`, a preconditioned CG on its contact set to 1 % in k, 7 to 11 operator
-applications; ``-bound_al_newton false``: the method of multipliers, lambda <- d), then by secants on (d, log P),
-kept inside the bracket the pairs give. The inner solves are inexact: one stops once its natural residual is below
-``-bound_al_eta`` times its load error (the stopping rule's ``inner_eta``): 0.3 for the quasi-Newton types with the
-Fourier H0, 0.1 for the others; only the last is solved to the tolerance (0.3 against 0.1: 3-19 % fewer pairs
-for BLMVM and BQNLS in 11 of 12 loads at N = 512 and 1024, 9 % more in one). The penalty c is in units of the compliance of the longest wavelength, L / pi (``-bound_al_penalty``):
-0.1 for the quasi-Newton types with the Fourier H0 (their first inner solve, at a poor lambda, is then cheap and
-the Newton step mends the load), 1 for the others. Penalties of 10 and more stall BLMVM and BQNLS near the start
-(natural residual about 3 after 1000 pairs, failed line searches), likely as the projection of each trial onto
-p >= 0 moves mean(p), which the penalty charges. ``-bound_load rootfind`` keeps the former method, a safeguarded
-root find on d around displacement-controlled solves (:mod:`~roughpetsc.solvers.root_find`).
-
-**The Fourier initial Hessian for the quasi-Newton types** (``-bound_h0 fourier|none``): BLMVM, BQNLS and the
-other BQNK types start each L-BFGS two-loop recursion from ``gamma B r``, B Polonsky-Keer's preconditioner on
-the free set (0 < p, or p at a bound with the gradient pointing inside) and ``gamma / diag(K)`` on the fixed
-nodes (:class:`FourierInitialHessian`); gamma corrects the scale from the exact minimiser along the line
-search's first trial after each direction (no operator application more). One FFT pair per quasi-Newton step,
-counted. With it an L-BFGS memory of one pair is the default, and BQNLS runs without its Bertsekas active-set
-estimate (which applies the initial Hessian a second time).
-
-**Fused callbacks.** The objective (exact increments, free of cancellation: TAO compares values that change by
-about residual^2) and the convergence test (natural residual, load error, the best iterate in one of two
-buffers) each make one pass over the vectors (:mod:`roughpetsc.contact.loops`), where numpy and Vec calls
-made about six and eleven.
-
-Working defaults for a shell Hessian are set before ``setFromOptions``, so that options override them: no TAO
-gradient tolerances (the natural-residual test decides), a high iteration limit (the BNK family stops at 50),
-subset type ``subvec`` for TRON and GPCG, CG as BNLS's KSP. The types that solve a Newton step with a KSP
-(BNLS, BNTR, BNTL, TRON, GPCG) get the Fourier preconditioner on the free set (``-bound_pc fourier``, the
-default of the BNK types), no PC (``none``, the default of TRON and GPCG), or what the options say
-(``options``). A TAO solve that stops for round-off is restarted from its best iterate while that lowers the
-residual.
+Registered under every name of :data:`BOUND_TYPES`. Load control by an augmented Lagrangian on mean(p) = pbar
+inside TAO, the Fourier initial Hessian of the quasi-Newton types, fused callbacks, working defaults: see
+docs/solvers.md, "The bound-constrained TAO types".
 """
 
 import ctypes
@@ -108,7 +62,8 @@ OPTIONS = [
                          "H0, 0.1 for the others)"),
     ("bound_al_max_outer", 40, "augmented Lagrangian: at most this many inner solves"),
     ("bound_al_recycle", False, "augmented Lagrangian: keep the quasi-Newton memory from one inner solve to the next"),
-    ("bound_al_newton", True, "augmented Lagrangian: first multiplier step by the contact stiffness (else lambda <- d)"),
+    ("bound_al_newton", True,
+     "augmented Lagrangian: first multiplier step by the contact stiffness (else lambda <- d)"),
 ]
 
 
@@ -124,12 +79,10 @@ def restartable(reason, watch):
 
 
 class AugmentedQuadratic:
-    """The objective L(p; lambda) of the module docstring and its gradient, the gap at d = lambda + c (mean p - pbar).
+    """The objective L(p; lambda) (docs/solvers.md) and its gradient, the gap at d = lambda + c (mean p - pbar).
 
-    ``penalty`` c = 0 and ``lam`` = d: the displacement-controlled QP ``1/2 p'Kp + p'(d - h)``. The value is
-    accumulated from exact increments, f(x) = f(r) + (x - r)'(g(x) + g(r)) / 2 (a quadratic in p for fixed
-    lambda), so that TAO's comparisons of values are free of cancellation; :meth:`configure` and
-    :meth:`restart` restart the values. The last evaluated point, its gap, its sum and its separation are cached.
+    c = 0 and lambda = d: the displacement-controlled QP. The value is accumulated from exact increments,
+    f(x) = f(r) + (x - r)'(g(x) + g(r)) / 2, free of cancellation; the last evaluated point is cached.
     """
 
     def __init__(self, problem):
@@ -173,7 +126,6 @@ class AugmentedQuadratic:
         problem.operator.displacement(x, out)
         out_local = out.getArray()
         if self.initial_lam:
-            # PK's separation of the start: zero mean gap on its contact set (no operator application more).
             elastic = problem.local(self.scratch)
             np.subtract(out_local.reshape(elastic.shape), problem.local(problem.heights, readonly=True), out=elastic)
             self.lam = problem.contact_separation(x, elastic)
@@ -193,11 +145,7 @@ class AugmentedQuadratic:
         return self.value
 
     def cached_gap(self, x):
-        """``(gap, sum of p, separation)`` of the iterate ``x``, the gap as this rank's flat array.
-
-        From the cache when ``x`` is the Vec last evaluated and unchanged since, or equal to the cached point;
-        else evaluated (an operator application), which moves the base of the increments to ``x``.
-        """
+        """``(gap, sum of p, separation)`` of ``x``, the gap as this rank's flat array: cached, else evaluated."""
         fresh = self.cached and x.handle == self.vec_handle and x.stateGet() == self.state
         fresh = bool(allmin(self.problem.mpi, [float(fresh)])[0])  # every rank must take the same branch
         if not fresh and not (self.cached and x.equal(self.point)):
@@ -210,10 +158,7 @@ class AugmentedQuadratic:
 
 
 class PenalizedCompliance(ShellContext):
-    """MATPYTHON context: the Hessian ``K + c/n 1 1' (+ a I)`` of the augmented Lagrangian (c = 0: K).
-
-    ``perturbation`` a is the BNK family's Hessian shift, reset by the owner at each Hessian evaluation.
-    """
+    """MATPYTHON context: the Hessian ``K + c/n 1 1' (+ a I)`` of the augmented Lagrangian, a the BNK shift."""
 
     def __init__(self, problem):
         super().__init__(problem.operator)
@@ -246,17 +191,8 @@ class PenalizedFourier(FourierPreconditioner):
 
 
 class FourierInitialHessian(PenalizedCompliance):
-    """MATPYTHON context of the quasi-Newton types' initial Hessian: ``mult`` is the exact Hessian, ``solve``
-    Polonsky-Keer's Fourier approximation of its inverse on the free set (module docstring).
-
-    PETSc's L-BFGS applies ``MatSolve`` of its J0 in every two-loop recursion; the free set is that of the
-    objective's last evaluated point, the current iterate. The symbol on a free set overestimates the inverse of
-    K restricted to it (the Schur complement (K^-1)_FF >= (K_FF)^-1), and the line search then cut the first
-    trial step by 3 to 10 every iteration; so the approximation is scaled by gamma, multiplied at the line
-    search's first trial after each direction by where the quadratic's minimum lies along the step (exact, from
-    s'g before and after the step), within :data:`GAMMA_BOUNDS`. (Scaling by the step the line search accepted
-    let gamma sink to its bound from a uniform start: 1751 operator applications against 220.)
-    """
+    """MATPYTHON context of the quasi-Newton types' initial Hessian: ``mult`` the exact Hessian, ``solve``
+    gamma times Polonsky-Keer's approximation of its inverse on the current free set (docs/solvers.md)."""
 
     def __init__(self, problem, objective):
         super().__init__(problem)
@@ -310,10 +246,7 @@ class FourierInitialHessian(PenalizedCompliance):
 
 
 def _set_lmvm_initial_hessian(tao, tao_type, mat):
-    """Make ``mat`` (with ``solve``) the initial Hessian J0 of the L-BFGS matrix of a BLMVM or BQNK ``tao``.
-
-    petsc4py 3.18 wraps TaoLMVMSetH0 (BLMVM) but not TaoGetLMVMMatrix (the BQNK types), which ctypes calls.
-    """
+    """Make ``mat`` the J0 of a BLMVM or BQNK ``tao`` (petsc4py 3.18 lacks TaoGetLMVMMatrix: ctypes)."""
     if tao_type == "blmvm":
         tao.setLMVMH0(mat)
         return
@@ -332,12 +265,9 @@ def _set_recycle(tao, flag):
 
 
 def contact_stiffness(problem, pressure, preconditioner, rtol=1e-2, max_it=30):
-    """The contact stiffness k = -dP/dd = 1_C' K_CC^-1 1_C / n of the solution ``pressure``, by PCG on its contact set C.
+    """The contact stiffness k = -dP/dd = 1_C' K_CC^-1 1_C / n of ``pressure``, by PCG on its contact set C.
 
-    The mean pressure of the displacement-controlled solution changes at this rate with the separation while
-    the contact set C (0 < p below the cap) stays. Preconditioned by Polonsky-Keer's Fourier preconditioner;
-    two operator applications per iteration; stops when k changes by less than ``rtol`` relatively. Returns k
-    (scaled), or None with C empty or every node.
+    Stops when k changes by less than ``rtol`` relatively. Returns k (scaled), or None with C empty or every node.
     """
     operator = problem.operator
     mpi = problem.mpi
@@ -382,11 +312,8 @@ def contact_stiffness(problem, pressure, preconditioner, rtol=1e-2, max_it=30):
 
 def next_multiplier(points, pbar, separation, stiffness=None):
     """The next lambda: a secant step on the (d, log P) pairs, inside their bracket; the first a Newton step with
-    the contact ``stiffness`` (the multiplier update, lambda <- d, without one).
-
-    P(d) decreases with d, like exp(-d / l) at small loads (Bush, Gibson and Thomas), so log P is closer to
-    linear in d than P, and the steps are taken on it. A pair with P > pbar lies below the root, one with
-    P < pbar above it.
+    the contact ``stiffness`` (lambda <- d without one). log P is nearly linear in d at small loads (P ~ exp(-d/l),
+    Bush, Gibson and Thomas).
     """
     below = [d for d, p in points if p > pbar]
     above = [d for d, p in points if p < pbar]
@@ -409,10 +336,7 @@ def next_multiplier(points, pbar, separation, stiffness=None):
 
 
 class BoundQP(Backend):
-    """A bound-constrained TAO type under load (augmented Lagrangian) or displacement control (module docstring).
-
-    Parameters are those of the registry's factories (``name``: the TAO type).
-    """
+    """A bound-constrained TAO type under load (augmented Lagrangian) or displacement control."""
 
     def __init__(self, problem, control, tao_type, settings):
         self.problem = problem
@@ -448,7 +372,6 @@ class BoundQP(Backend):
         tao.setOptionsPrefix(settings.prefix)
         tao.setType(tao_type)
         if tao_type in KSP_TYPES and preconditioner == "fourier":
-            # The inverse symbol on the free set, through the Hessian's preconditioning matrix and PC "mat".
             self.fourier = FourierPreconditioner(problem)
             self.preconditioning = self.fourier.mat()
             tao.getKSP().getPC().setType("mat")
@@ -508,7 +431,7 @@ class BoundQP(Backend):
 
     @PETSc.Log.EventDecorator("RPBoundTest")  # -log_view: the fused convergence test
     def _natural_residual(self, tao):
-        """The convergence test's ``(natural, load error, fresh)`` in one pass, the iterate copied to the spare buffer."""
+        """The convergence test's ``(natural, load error, fresh)`` in one pass; the iterate goes to the spare buffer."""
         problem = self.problem
         x = tao.getSolution()
         gap, total, separation = self.objective.cached_gap(x)
@@ -527,7 +450,7 @@ class BoundQP(Backend):
         self.best = 1 - self.best  # the spare buffer holds the iterate just tested
 
     def _run(self, pressure, test):
-        """TAO from ``pressure``, restarted from its best iterate while round-off stops it; ``(iterations, restarts)``."""
+        """TAO from ``pressure``, restarted from its best iterate while round-off stops it; (iterations, restarts)."""
         iterations, restarts, floor = 0, 0, np.inf
         while True:
             self.objective.restart()
@@ -557,8 +480,7 @@ class BoundQP(Backend):
     def solve(self, target, pressure, guess=None, history=None):
         """Solve for ``target`` (scaled mean pressure or separation) from ``pressure`` (overwritten).
 
-        ``history`` (:class:`~roughpetsc.solvers.stopping.History`) collects the residuals of several solves
-        (a root find's); a fresh one by default.
+        ``history`` collects the residuals of several solves (a root find's); a fresh one by default.
         """
         self._project(pressure)
         history = history or History(self.problem)
@@ -581,7 +503,7 @@ class BoundQP(Backend):
         return Outcome(separation, iterations, describe_stop(reason, test.watch, restarts), history.as_array())
 
     def _solve_load(self, pbar, pressure, guess, test, history):
-        """The augmented Lagrangian on mean(p) = pbar (module docstring); lambda starts at ``guess.separation``."""
+        """The augmented Lagrangian on mean(p) = pbar; lambda starts at ``guess.separation``."""
         problem = self.problem
         grid = problem.scaled_grid
         penalty = self.penalty_factor * max(grid.l0, grid.l1) / np.pi
@@ -622,7 +544,6 @@ class BoundQP(Backend):
 
     def destroy(self):
         self.tao.destroy()
-        # (PETSc destroys the contexts of the python Mats with them.)
         for obj in (self.objective, *self.buffers, self.lower, self.upper, self.gradient, self.hessian,
                     self.preconditioning, self.fourier, self.initial_hessian, self.stiffness_preconditioner):
             if obj is not None:
@@ -630,7 +551,7 @@ class BoundQP(Backend):
 
 
 def make_bound(problem, control, tao_type, settings):
-    """The bound type ``tao_type``: :class:`BoundQP`, or under load control with ``-bound_load rootfind`` the root find."""
+    """The bound type ``tao_type``: :class:`BoundQP`, or under load control with ``-bound_load rootfind`` RootFind."""
     method = PETSc.Options(settings.prefix).getString("bound_load", "al")
     if method not in LOAD_METHODS:
         raise UserError(f"{option_name('bound_load', settings.prefix)}: unknown method '{method}' "

@@ -1,10 +1,4 @@
-"""The solver facade: one backend for a problem of any kind, warm starts along loads, every result certified.
-
-:class:`Solver` resolves the backend by the problem's kind and a name through
-:mod:`~roughpetsc.solvers.registry`, holds the unknown in the problem's continuation (which starts each
-solve from the previous solutions), and turns the backend's :class:`~roughpetsc.solvers.protocol.Outcome`
-into a :class:`~roughpetsc.contact.Result` through the problem's certificate, computed afresh.
-"""
+"""The solver facade: one backend for a problem of any kind, warm starts along loads, every result certified."""
 
 import time
 
@@ -23,36 +17,29 @@ class Solver:
     Parameters
     ----------
     problem : ContactProblem or AdhesiveProblem
-        Any problem of the protocol of :mod:`roughpetsc.solvers.protocol`.
     control : "load" or "displacement"
-        One of ``problem.controls``.
     tao_type : str or None
         A registered name for the problem's kind (:func:`~roughpetsc.solvers.registry.backend_names`);
-        None reads ``-tao_type`` under ``prefix`` (from ``options`` or the command line), and without one
-        the kind's default: Polonsky-Keer for the contact problem, the projected CG on the gap for the
-        adhesive one.
+        None reads ``-tao_type`` under ``prefix``, and without one the kind's default (``pk``, ``gapcg``).
     rtol : float
         Stopping tolerance on the natural KKT residual (and the error of the prescribed load or mean gap).
     prefix : str or None
-        Options prefix of the solver's TAO objects and of its own options (``-bound_pc``, ``-pk_pc``,
-        ``-solve_max_time``, ``-tao_max_it``, ...); None reads them unprefixed, as the command line gives them.
+        Options prefix of the solver's TAO objects and of its own options; None: unprefixed.
     options : dict or None
         Options for this solver alone (``{"tao_type": "bqnls", "tao_max_it": 500}``, names without dash or
-        prefix): set under the prefix while the solver lives (:class:`~roughpetsc.solvers.options.SolverOptions`;
-        without a prefix they get one of their own). An option given here that nothing reads is an error.
+        prefix), set under the prefix while the solver lives. An option given here that nothing reads is an error.
 
     Attributes
     ----------
     name : str
-        The solver's name in results: the TAO type, ``<type>(al)`` (load control), ``rootfind(<type>)`` (``-bound_load rootfind``), ``almm``, ``pk(<pc>)``, ``gapcg``.
-    backend :
-        The backend object (:mod:`roughpetsc.solvers.protocol`).
+        The solver's name in results: the TAO type, ``<type>(al)``, ``rootfind(<type>)``, ``almm``, ``pk(<pc>)``,
+        ``gapcg``.
     """
 
     def __init__(self, problem, control, tao_type=None, rtol=1e-8, prefix=None, options=None):
         if control not in problem.controls:
-            raise ParameterError("control", f"the {problem.kind} problem is solved under {' or '.join(problem.controls)} "
-                                            f"control, not {control}")
+            raise ParameterError("control", f"the {problem.kind} problem is solved under "
+                                            f"{' or '.join(problem.controls)} control, not {control}")
         self.problem = problem
         self.control = control
         self.rtol = rtol
@@ -87,7 +74,7 @@ class Solver:
 
     @property
     def tao(self):
-        """The backend's TAO object (the inner one of the root find): for monitors and views."""
+        """The backend's TAO object: for monitors and views."""
         return self.backend.tao
 
     def unusable_options(self):
@@ -97,9 +84,8 @@ class Solver:
     def solve(self, pbar=None, pstar=None, gbar=None, start=None):
         """Solve one load; the previous solution is the start. Returns a :class:`~roughpetsc.contact.Result`.
 
-        Give ``pbar`` (mean pressure) or ``pstar`` (= pbar / sqrt(m0^p)) under load control, ``gbar``
-        (the mean gap, which is the rigid separation (3.38) of the dissertation) under displacement
-        control. ``start`` names another start than the previous solution (the continuation's ``start``).
+        Give ``pbar`` or ``pstar`` (= pbar / sqrt(m0^p)) under load control, ``gbar`` (the mean gap, the rigid
+        separation (3.38)) under displacement control. ``start`` names another start (the continuation's).
         """
         problem = self.problem
         started = time.perf_counter()

@@ -1,25 +1,7 @@
 """Projected conjugate gradients on the gap for adhesive contact (:class:`roughpetsc.contact.AdhesiveProblem`).
 
-The algorithm of Rey, Anciaux and Molinari (Comput. Mech. 60, 2017), Polonsky-Keer's CG with the gap
-as the unknown and the mean gap as the constraint, with three changes of ours:
-
-* the search direction is preconditioned by the compliance (the inverse symbol 1 / (pi E* |k|) of the
-  Hessian S, as Polonsky-Keer on the pressure is preconditioned by the stiffness; Vollebregt, J.
-  Comput. Phys. 257, 2014), restricted to the free set and kept at zero mean there;
-* the free set is the nodes out of contact and the contact nodes whose contact pressure is negative
-  (they open along the direction itself, as in Vollebregt's BCCG), with the Polak-Ribiere beta
-  clipped at 0 so conjugacy survives changes of the set;
-* the step minimises the quadratic model with the law's curvature phi'' when that model is convex and
-  the elastic one otherwise, and is then cut back until the energy decreases (Armijo), since phi makes
-  the energy non-convex: the iterates follow the energy downhill to the local minimum next to the
-  start, which is what a quasi-static path of adhesive contact needs. A step that needs the projection
-  is kept only if the projected gap's energy is lower, and a solve whose energy still falls is not
-  stagnating (a descent past a jump out of contact can take hundreds of iterations at a large residual).
-
-After each step the gap is projected onto {g >= 0, mean g = gbar} exactly (a shift of the positive
-nodes found by Newton's method on a piecewise-linear function). Every stop is decided on a freshly
-computed S g; a stop short of the tolerance returns an iterate whose residual is within a factor 2 of the
-lowest it saw (a copy is kept each time the residual halves, not at every iteration).
+Rey, Anciaux and Molinari (Comput. Mech. 60, 2017), preconditioned by the compliance, with a BCCG free set
+and an Armijo line search on the non-convex energy: docs/solvers.md.
 """
 
 import numpy as np
@@ -44,8 +26,7 @@ ENERGY_PROGRESS = 1e-10
 def project_mean(mpi, g, target, n):
     """``g <- max(g - c, 0)`` with c such that the mean of g is ``target`` (in place).
 
-    ``f(c) = sum max(g - c, 0) - n target`` is convex, decreasing and piecewise linear; Newton's method
-    from the uniform shift (where f >= 0) increases c monotonically to the root in a few steps.
+    Newton's method on the convex, decreasing, piecewise-linear ``sum max(g - c, 0) - n target``.
     """
     total, = allsum(mpi, [g.sum()])
     c = (total - n * target) / n
@@ -61,7 +42,7 @@ def project_mean(mpi, g, target, n):
 
 
 class _Scratch:
-    """The local arrays of one solve, allocated once: the loop makes no N^2 temporaries."""
+    """The local arrays of one solve, allocated once."""
 
     def __init__(self, size):
         self.r = np.empty(size)
@@ -78,14 +59,7 @@ class _Scratch:
 class GapCG:
     """The projected CG on the gap as the context of a TAO of type ``python`` (so -tao_monitor, -tao_max_it work).
 
-    Before ``tao.solve`` set :attr:`target` (the scaled mean gap). The TAO's solution is the gap; it holds
-    the start and receives the solution. The stopping rule is checked through the TAO's convergence test
-    once per iteration, on a freshly computed S g before convergence is declared.
-
-    Parameters
-    ----------
-    problem : AdhesiveProblem
-    rule : StoppingRule
+    Before ``tao.solve`` set :attr:`target` (the scaled mean gap); the TAO's solution is the gap.
     """
 
     def __init__(self, problem, rule):
@@ -206,11 +180,7 @@ class GapCG:
         """Step the gap of ``gap_vec`` along -t by the first of ``step``, step/2, ... that lowers the energy enough;
         ``(change of the energy, whether S g was computed afresh)``, or (None, False) if no step does.
 
-        Armijo's test is on the line before the projection (:func:`_armijo_step`). A step that crosses g = 0 is
-        projected and kept only if the energy of the projected gap, on a fresh S g, is below that before
-        the step: the line continues phi below 0 by its tangent, so a long step there can look downhill and
-        project to a gap of higher energy in another basin (a retraction past snap-off that jumped back
-        into a wider contact, and stagnated there).
+        A step that crosses g = 0 is kept only if the projected gap's energy, on a fresh S g, is lower.
         """
         problem = self.problem
         elastic_vec = self.vecs[4]
@@ -277,10 +247,7 @@ def _law_curvature(law, mpi, g, t, work):
 def _feasible(mpi, t, r, open_nodes, open_count):
     """Make ``-t`` a feasible direction at g = 0 (in place); returns the slope ``<r, t>`` of the energy.
 
-    A contact node (g = 0) may only open: where t > 0 it is set to 0, and the mean of t is restored on
-    the ``open_count`` nodes out of contact (``open_nodes``, g > 0), which can move either way; small
-    steps along -t then need no projection, so the energy change of the line search is that of the
-    projected iterate.
+    A contact node may only open: t > 0 there is set to 0, and the mean of t restored on the open nodes.
     """
     total, = allsum(mpi, [loops.close_contact_nodes(t, open_nodes)])
     slope, = allsum(mpi, [loops.shift_open_slope(t, open_nodes, total / open_count, r)])
@@ -291,11 +258,8 @@ def _armijo_step(problem, g, t, slope, curvature_elastic, elastic_slope, step, t
     """The first of ``step``, step/2, ... along -t that decreases the energy enough, and that decrease (None, None if
     none does).
 
-    The test is on the energy along the line before the projection (phi continued below g = 0 by its
-    tangent, :meth:`energy_change` of the laws), whose slope at 0 is exactly ``slope``; the projection
-    follows, as in Polonsky-Keer. The change is summed from node-wise changes, so it does not cancel near
-    the solution: the elastic part is the quadratic -s <S(g + h), t> + s^2/2 <t, S t>, the law's part
-    sum (phi(g - s t) - phi(g)). ``trial`` and the two arrays of ``law_scratch`` are scratch of g's size.
+    The test is on the line before the projection (phi continued below g = 0 by its tangent). The change is
+    summed node-wise, free of cancellation: -s <S(g + h), t> + s^2/2 <t, S t> + sum (phi(g - s t) - phi(g)).
     """
     law, mpi = problem.scaled_law, problem.mpi
     changes = law.energy_changes_from(g, law_scratch)

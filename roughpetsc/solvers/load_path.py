@@ -1,8 +1,7 @@
 """The one load-path driver: a solver along a list of loads, each step warm-started, a callback after each.
 
-The command line's path (``-pstar_list``, ``-gbar_list``), the ensembles (the history (7.11) per surface),
-the adhesive approach-retraction cycles and the studies all run :func:`drive`; :func:`load_path` is its
-generator for the Python API, making and destroying the :class:`~roughpetsc.solvers.facade.Solver`.
+:func:`drive` runs every path (command line, ensembles, adhesive cycles); :func:`load_path` is its generator
+for the Python API.
 """
 
 from petsc4py import PETSc
@@ -15,12 +14,10 @@ LOAD_KINDS = ("pstar", "pbar", "gbar")
 
 
 def drive(solver, steps, on_step=None, first=0, on_start=None):
-    """Solve ``steps`` (``(kind, value)`` pairs, kind one of pstar, pbar, gbar) in order with ``solver``.
+    """Solve ``steps`` (``(kind, value)`` pairs, kind one of pstar, pbar, gbar) in order; yields each result.
 
-    Each step runs in a PETSc log stage of its own (``-log_view``: ``RP step NNN kind=value``); ``on_step(index,
-    kind, value, result)`` is called after each, before the next starts (it may record, checkpoint, print or
-    raise to stop), and ``on_start(index, kind, value)`` before each. ``first`` skips the steps before it (a
-    resumed path). Yields each result.
+    Each step runs in a PETSc log stage of its own; ``on_start(index, kind, value)`` is called before each,
+    ``on_step(index, kind, value, result)`` after each. ``first`` skips the steps before it (a resumed path).
     """
     for index, (kind, value) in enumerate(steps):
         if index < first:
@@ -42,11 +39,8 @@ def drive(solver, steps, on_step=None, first=0, on_start=None):
 
 def load_path(problem, pstars=None, pbars=None, gbars=None, tao_type=None, rtol=1e-8, prefix=None, options=None,
               on_step=None):
-    """A generator of :class:`~roughpetsc.contact.Result` along the loads, in the order given.
-
-    Each solve starts from the previous solutions (the problem's continuation), as the load history (7.11)
-    of the dissertation is meant to be solved. The Solver is made at the first result and destroyed when the
-    generator ends or is closed (``close()``, or garbage collection of an unfinished generator).
+    """A generator of :class:`~roughpetsc.contact.Result` along the loads, each warm-started, as the load
+    history (7.11) is solved. The Solver is made at the first result and destroyed when the generator ends.
 
     Parameters
     ----------
@@ -58,11 +52,6 @@ def load_path(problem, pstars=None, pbars=None, gbars=None, tao_type=None, rtol=
         As for :class:`~roughpetsc.solvers.facade.Solver`.
     on_step : callable, optional
         ``on_step(index, kind, value, result)`` after each step (:func:`drive`).
-
-    Examples
-    --------
-    >>> for result in load_path(problem, pstars=[0.1, 0.2, 0.4]):  # doctest: +SKIP
-    ...     print(result.pstar, result.A)
     """
     given = {name: loads for name, loads in (("pstar", pstars), ("pbar", pbars), ("gbar", gbars))
              if loads is not None}

@@ -1,8 +1,4 @@
-"""Options of the solver objects: scoped defaults, ``setFromOptions`` with a clear error, the time limit.
-
-Every TAO object of a solver carries the options prefix its :class:`~roughpetsc.solvers.solver.Solver`
-was given (None: the unprefixed command line); everything here reads and writes options under that prefix.
-"""
+"""Options of the solver objects under their prefix: scoped defaults, ``setFromOptions`` with a clear error."""
 
 import ctypes
 import ctypes.util
@@ -27,8 +23,7 @@ def _petsc_library():
 def stop_subsolver(tao):
     """Set the reason of ALMM's subsolver to DIVERGED_USER, so that its solve ends at its next convergence test.
 
-    TAO's default test leaves a reason already set. petsc4py 3.18 does not wrap ``TaoALMMGetSubsolver``,
-    so it and ``TaoSetConvergedReason`` are called through ctypes.
+    petsc4py 3.18 does not wrap ``TaoALMMGetSubsolver``: ctypes.
     """
     library = _petsc_library()
     subsolver = ctypes.c_void_p()
@@ -53,11 +48,8 @@ def set_from_options(tao, cleanup):
 def default_options(defaults, prefix=None, replace=False):
     """Options that apply inside the block unless the user gave them; removed again afterwards.
 
-    The working defaults of one solver object must not stay in the options database, where they
-    would become the next object's settings (BNLS's CG made a later BNTR refuse its KSP).
-
-    ``replace=True`` sets them even over a value the user gave, which is restored afterwards (and
-    counted as read: the caller has consumed it).
+    Left in the database they would become the next object's settings (BNLS's CG made a later BNTR refuse
+    its KSP). ``replace=True`` sets them over a value the user gave, restored afterwards (counted as read).
     """
     options = PETSc.Options(prefix)
     given = {name: options.getString(name) for name in defaults if replace and options.hasName(name)}
@@ -111,8 +103,7 @@ def _is_this_database(library):
 def petsc_library():
     """``(ctypes handle of the PETSc library in use, None)``, or ``(None, why it was not found)``.
 
-    petsc4py 3.18 does not expose PetscOptionsLeftGet (nor which options were queried), so the
-    check of unused options calls it through ctypes in the library petsc4py has loaded.
+    petsc4py 3.18 does not expose PetscOptionsLeftGet, which the check of unused options needs.
     """
     tried = []
     for path in _library_candidates():
@@ -131,8 +122,7 @@ def petsc_library():
 def unused_options():
     """Names of options in the database that nothing has read so far (PetscOptionsLeftGet).
 
-    None if this platform's PETSc cannot be asked; a :class:`RuntimeWarning` then says why (Python
-    shows it once).
+    None, with a :class:`RuntimeWarning` saying why, if this platform's PETSc cannot be asked.
     """
     library, why = petsc_library()
     if library is None:
@@ -185,17 +175,9 @@ def _option_text(value):
 class SolverOptions:
     """The options of one solver: set under its prefix for its lifetime, read by its objects, then removed.
 
-    As the options managers of dolfinx and Firedrake: ``options`` (names without dash or prefix, e.g.
-    ``{"tao_type": "bqnls", "tao_max_it": 500, "bound_pc": "fourier"}``) are put into PETSc's options
-    database under ``prefix`` when the solver is made, so that ``setFromOptions`` of its TAO, KSP and PC
-    and our own option reads see them; :meth:`destroy` removes them and restores what the database held
-    before. Without a prefix, options given here get one of their own (``rp<id>_``), so that they never
-    leak into other solvers or the command line's options.
-
-    Attributes
-    ----------
-    prefix : str or None
-        The options prefix of the solver's objects (None: the unprefixed command-line options).
+    As the options managers of dolfinx and Firedrake: ``options`` (names without dash or prefix) go into
+    PETSc's database under ``prefix``; :meth:`destroy` removes them and restores what was there. Without a
+    prefix, options given here get one of their own (``rp<id>_``), so that they never leak.
     """
 
     def __init__(self, prefix=None, options=None):
@@ -239,10 +221,8 @@ class SolverOptions:
 def python_tao(comm, context, prefix=None):
     """A TAO of type ``python`` around ``context`` (Polonsky-Keer, the gap CG), set from the options under ``prefix``.
 
-    ``-tao_type`` names the backend, not a TAO type: this TAO reads ``python`` instead. The iteration limit
-    starts at :data:`~roughpetsc.solvers.stopping.DEFAULT_MAX_IT` (``-tao_max_it`` changes it). A value the
-    context refused in its ``setFromOptions`` (kept in its ``option_error``) is raised here, once PETSc's
-    options block is closed.
+    ``-tao_type`` names the backend, so this TAO reads ``python`` instead. A value the context refused in its
+    ``setFromOptions`` (its ``option_error``) is raised here, once PETSc's options block is closed.
     """
     from .stopping import DEFAULT_MAX_IT
 

@@ -1,9 +1,6 @@
-"""Polonsky-Keer as a solver backend: the TAO ``python`` object around :mod:`~roughpetsc.solvers.polonsky_keer`.
+"""Polonsky-Keer as a solver backend (``pk``, ``none``, ``python``; the default): a TAO ``python`` object.
 
-Registered as ``pk`` (also ``none`` and ``python``, the names of the command line) under load and
-displacement control; it is the default backend. Along a load path it accepts the start's K p from
-the facade's predictor (``keeps_displacement``) and, under load control, stops without a fresh
-confirming K p when the facade certifies the result itself (:class:`~roughpetsc.solvers.protocol.Guess`).
+Along a load path it accepts the start's K p from the facade's predictor (``keeps_displacement``).
 """
 
 import numpy as np
@@ -16,7 +13,6 @@ from .root_find import RootFind
 from .stopping import describe_stop
 
 NAMES = ("pk", "none", "python")
-# The options of Polonsky-Keer, read by PolonskyKeer.setFromOptions under the solver's prefix.
 OPTIONS = [
     ("pk_pc", "fourier", "Polonsky-Keer preconditioner: fourier (inverse symbol pi E*|k| on the contact set) | none"),
     ("pk_active_set", "bccg", "Polonsky-Keer active set: bccg (overlapping nodes join the free set, Polak-Ribiere "
@@ -28,17 +24,7 @@ OPTIONS = [
 class PKBackend(Backend):
     """Polonsky-Keer (projected, preconditioned CG) as a TAO of type ``python`` (so -tao_monitor etc. work).
 
-    ``solve(target, pressure, guess)`` takes the scaled mean pressure under load control, the scaled
-    separation under displacement control; under displacement control it is also the inner solver of
-    :class:`~roughpetsc.solvers.root_find.RootFind` (``separation``, ``max_seconds``, ``history=``).
-
-    Parameters
-    ----------
-    problem : ContactProblem
-    control : "load" or "displacement"
-    name : str
-        Unused (one of :data:`NAMES`); part of the factory signature of the registry.
-    settings : roughpetsc.solvers.protocol.BackendSettings
+    Under displacement control also the inner solver of :class:`~roughpetsc.solvers.root_find.RootFind`.
     """
 
     keeps_displacement = True
@@ -65,10 +51,7 @@ class PKBackend(Backend):
         return given_but_unusable(PARTS_UNUSED_BY_PYTHON_TAO, self.prefix)
 
     def solve(self, target, pressure, guess=None, history=None):
-        """Solve for ``target`` from ``pressure`` (overwritten), starting from ``guess.displacement`` if known.
-
-        ``history`` (:class:`~roughpetsc.solvers.stopping.History`), if given, receives the residuals too.
-        """
+        """Solve for ``target`` from ``pressure`` (overwritten); ``history``, if given, receives the residuals too."""
         context = self.context
         guess = guess or Guess()
         if self.control == "load":
@@ -97,10 +80,8 @@ class PKBackend(Backend):
 class CappedPKLoad(Backend):
     """Load control under a hardness cap: PK's own load control, and the root find around PK if that fails.
 
-    PK's rescaling to the load works while elastic nodes can take the load that the cap refuses; when
-    the capped nodes carry it nearly all (a fully plastic contact that must grow) it stagnates (measured: at a
-    load error of 0.4 on the Westergaard wave with H = 1.2 pbar), and the root find on the separation around
-    displacement-controlled PK (several PK solves) takes over from the start the failed attempt left.
+    PK's rescaling stagnates when the capped nodes carry nearly all the load (measured: at a load error of 0.4
+    on the Westergaard wave with H = 1.2 pbar); the root find then takes over from where it stopped.
     """
 
     def __init__(self, problem, control, name, settings):

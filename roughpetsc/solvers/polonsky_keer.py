@@ -22,17 +22,8 @@ ACTIVE_SETS = ("pk", "bccg")
 class PolonskyKeer:
     """The context of a TAO of type ``python``.
 
-    Before ``tao.solve`` set either ``target_pbar`` (load control, scaled
-    mean pressure; ``target_separation`` None) or ``target_separation``
-    (displacement control, scaled rigid separation d): then the same projected
-    CG runs with d fixed, no mean removal and no rescaling.
-
-    Parameters
-    ----------
-    problem : ContactProblem
-    rule : StoppingRule
-        When a solve stops: through the TAO's convergence test, which :meth:`solve` sets and calls once per
-        iteration (:func:`~roughpetsc.solvers.stopping.check_convergence`), as TAO's own types do.
+    Before ``tao.solve`` set either ``target_pbar`` (load control, scaled mean pressure; ``target_separation``
+    None) or ``target_separation`` (displacement control, scaled rigid separation d, held fixed).
     """
 
     def __init__(self, problem, rule):
@@ -58,12 +49,10 @@ class PolonskyKeer:
         self.fourier = FourierPreconditioner(problem)
 
     def setFromOptions(self, tao):
-        """Read ``-pk_pc none|fourier``, ``-pk_active_set bccg|pk`` and ``-pk_refresh N`` (recompute ``K p`` at least
-        every N iterations) under the TAO's options prefix.
+        """Read ``-pk_pc``, ``-pk_active_set`` and ``-pk_refresh`` under the TAO's options prefix.
 
-        Called by ``tao.setFromOptions()``. A refused value is kept in :attr:`option_error` (a
-        :class:`UserError`) for the caller to raise once ``setFromOptions`` has returned: an
-        exception raised inside this callback would leave PETSc's options block open.
+        A refused value is kept in :attr:`option_error` for the caller to raise: an exception raised inside
+        this callback would leave PETSc's options block open.
         """
         prefix = tao.getOptionsPrefix()
         options = PETSc.Options(prefix)
@@ -233,8 +222,7 @@ class PolonskyKeer:
         tao.setConvergedReason(reason)
 
     def _report(self, p, gap, total, pbar, upper):
-        """The KKT report of the iterate (``gap += separation`` on the way), as :func:`~roughpetsc.kkt.report`
-        without its feasibility minima; ``total`` is the global sum of p."""
+        """The KKT report of the iterate (``gap += separation`` on the way), without feasibility minima."""
         problem = self.problem
         mean_p = total / problem.n
         scale = pbar if pbar else (mean_p if mean_p > 0 else 1.0)
@@ -246,11 +234,7 @@ class PolonskyKeer:
                          load_error=None if pbar is None else float(abs(mean_p - pbar) / pbar))
 
     def _interference_start(self, pressure, p, h):
-        """Under displacement control, an empty start becomes the best multiple of the interference.
-
-        ``v = max(h - d, 0)`` scaled by ``c = <v, h - d> / <v, K v>``, the minimiser of the QP along v
-        (one operator application).
-        """
+        """Under displacement control, an empty start becomes ``c max(h - d, 0)``, c the QP's minimiser along it."""
         problem = self.problem
         total, = allsum(problem.mpi, [p.sum()])
         if total > 0:
@@ -268,10 +252,7 @@ class PolonskyKeer:
     def _restore_load_below_cap(self, p, displacement, total_load, upper):
         """Rescale the nodes below the cap ``upper`` so that ``sum(p) = total_load``; True if K p is stale.
 
-        The capped nodes keep ``p = upper``; a node that the rescaling lifts above the cap is capped in
-        turn (a few rounds at most). While no node is capped this is the uniform rescaling, which
-        ``displacement`` (K p) follows exactly; otherwise p changes other than by a factor and K p must
-        be computed afresh.
+        A node lifted above the cap is capped in turn. K p follows exactly only while no node is capped.
         """
         mpi = self.problem.mpi
         stale = False

@@ -46,19 +46,15 @@ class FourierPreconditioner:
 
     @PETSc.Log.EventDecorator("RPFourierPC")  # -log_view: one application of B, its FFT pair included
     def apply(self, residual, out, contact, count, keep_load, rigid_compliance=np.inf):
-        """``out = B residual`` on local flat arrays; ``residual`` vanishes off the contact set.
+        """``out = B residual`` on local flat arrays; ``residual`` vanishes off C (``contact`` 1.0 on C, |C| ``count``).
 
-        ``contact`` is 1.0 on C and 0.0 elsewhere, ``count`` the global |C|.
-        ``keep_load``: load control; the residual must then have zero mean on
-        C, and the mean-mode term is dropped (directions keep the mean pressure).
-        ``rigid_compliance``: the lambda_C to use when C is every node, where K 1 = 0 (the uniform
-        pressure is the rigid mode); infinite drops the mean mode there, as PK wants.
+        ``keep_load``: the residual has zero mean on C, and the mean-mode term is dropped. ``rigid_compliance``:
+        the lambda_C when C is every node (K 1 = 0); infinite drops the mean mode there, as PK wants.
         """
         problem = self.problem
         operator = problem.operator
         shape = operator.local_shape
-        if keep_load:
-            # The caller's residual has zero mean on C already (load control): P residual = residual.
+        if keep_load:  # P residual = residual
             operator.stiffness(residual.reshape(shape), out.reshape(shape))
         else:
             residual_sum, = allsum(problem.mpi, [residual.sum()])
@@ -74,13 +70,8 @@ class FourierPreconditioner:
                 compliance = rigid_compliance
             out += MEAN_MODE_WEIGHT * residual_mean / compliance * contact
 
-    # --- as a TAO Hessian preconditioning matrix --------------------------
     def mat(self):
-        """A python Mat applying ``B`` with C = all nodes; its ``createSubMatrix`` gives ``B`` on a free set.
-
-        Give it to TAO as the Hessian's preconditioning matrix and set the KSP's
-        PC to type ``mat``. Destroy it when done.
-        """
+        """A python Mat applying ``B`` with C = all nodes (``createSubMatrix``: on a free set), for PC type ``mat``."""
         return self.problem.operator.mat(_RestrictedMat(self, None))
 
 

@@ -1,7 +1,4 @@
-"""The two protocols of the solver layer: what a problem offers the solvers, and what a backend offers the facade.
-
-The protocols in full: docs/solvers.md, "The protocols (`solvers/protocol.py`)".
-"""
+"""The two protocols of the solver layer (docs/solvers.md): what a problem offers, what a backend offers."""
 
 from dataclasses import dataclass
 
@@ -24,9 +21,8 @@ class Outcome:
     history : ndarray (k, 4)
         Iteration, natural residual, operator applications, seconds (:class:`~roughpetsc.solvers.stopping.History`).
     confirmed : bool
-        False when the backend stopped on an updated gradient without a freshly computed one (allowed by
-        ``Guess.confirm = False``): if the certificate then fails, the facade solves again with
-        ``confirm = True``.
+        False when the backend stopped on an updated gradient (``Guess.confirm = False``): if the
+        certificate fails, the facade solves again with ``confirm = True``.
     """
 
     separation: float
@@ -45,11 +41,9 @@ class Guess:
     separation : float or None
         The separation of the previous solution (scaled), a first guess for a root find on d.
     displacement : petsc4py.PETSc.Vec or None
-        K p of the start, when the load-path predictor knows it (the backend may skip one operator
-        application); only offered to backends with ``keeps_displacement``.
+        K p of the start, when the load-path predictor knows it (backends with ``keeps_displacement``).
     confirm : bool
-        True: the backend confirms its convergence on a freshly computed gradient. False: it may stop on
-        an updated one, because the facade certifies every result afresh anyway.
+        Whether the backend confirms its convergence on a freshly computed gradient.
     """
 
     separation: float = None
@@ -62,7 +56,6 @@ class BackendSettings:
     """What every backend is built with besides the problem and its control.
 
     rule : StoppingRule
-        The stopping rule of every solve (tolerance, time limit, stagnation).
     prefix : str or None
         Options prefix of the backend's TAO objects and its own options (None: unprefixed options).
     """

@@ -1,12 +1,6 @@
 """Solver backends by problem kind, name and control: each backend module registers its factory in one line.
 
-The names are those of ``-tao_type`` (and of ``Solver(..., tao_type=...)``): for the elastic contact
-problem the bound-constrained TAO types, ``almm`` and ``pk`` (also ``none``, ``python``, or no name: the
-default); for the adhesive problem ``gapcg`` (the default) and ``almm``. A name may mean a different
-backend under each control (a bound type is the QP itself under displacement control and an augmented
-Lagrangian on the load around it under load control). A new solver or physics registers
-``register(name, factory, controls, kinds)`` in its own module, imported by :mod:`roughpetsc.solvers`, and
-declares its options in a table (:func:`option_tables`).
+The names are those of ``-tao_type``; a name may mean a different backend under each control.
 """
 
 from ..errors import ParameterError
@@ -17,7 +11,6 @@ KINDS = ("contact", "adhesive")
 DEFAULT_NAMES = {"contact": "pk", "adhesive": "gapcg"}
 
 
-# The one registry of the package, filled by the backend modules when roughpetsc.solvers imports them:
 # (kind, name, control) -> factory(problem, control, name, settings), and backend name -> its option table.
 FACTORIES = {}
 OPTIONS = {}
@@ -31,12 +24,11 @@ def register(name, factory, controls=CONTROLS, kinds=("contact",), options=()):
     name : str or sequence of str
         The name, or the names the factory answers to (it receives the one asked for).
     factory : callable
-        Returns a backend (:mod:`roughpetsc.solvers.protocol`); ``settings`` is a
-        :class:`~roughpetsc.solvers.protocol.BackendSettings`.
+        Returns a backend (:mod:`roughpetsc.solvers.protocol`).
     controls : sequence of "load", "displacement"
     kinds : sequence of "contact", "adhesive"
     options : sequence of (name, default, help)
-        The backend's own options (read under the solver's prefix), for ``-help`` and the check of names.
+        The backend's own options, for ``-help`` and the check of names.
     """
     for control in controls:
         if control not in CONTROLS:
@@ -71,8 +63,7 @@ def backend_names(control=None, kind="contact"):
 def resolve(name, control, kind="contact"):
     """The registered name that ``name`` means for ``kind`` under ``control`` (None or "": the default).
 
-    Raises :class:`~roughpetsc.errors.ParameterError` for ``tao_type`` (an unknown name, or a
-    backend that does not solve ``control``) or ``control``.
+    Raises :class:`~roughpetsc.errors.ParameterError` for an unknown name or control.
     """
     if control not in CONTROLS:
         raise ParameterError("control", f"the control is 'load' or 'displacement', got '{control}'")

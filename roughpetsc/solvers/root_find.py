@@ -1,8 +1,6 @@
 """Load control by a safeguarded root find on the rigid separation around the displacement-controlled QP (3.41)-(3.44).
 
-The load control of the bound types with ``-bound_load rootfind`` (:func:`~roughpetsc.solvers.bound_qp.make_bound`),
-and of Polonsky-Keer under a hardness cap when its own load control fails
-(:class:`~roughpetsc.solvers.pk.CappedPKLoad`).
+Used by the bound types with ``-bound_load rootfind`` and by Polonsky-Keer under a hardness cap.
 """
 
 import math
@@ -18,22 +16,13 @@ from .protocol import Backend, Outcome
 class RootFind(Backend):
     """Load control by a safeguarded root find on the separation around :class:`BoundQP`.
 
-    The mean pressure P(d) of the displacement-controlled solution decreases
-    from the complete-contact pressure max(-p_c) at d -> 0+ to 0 at d = max(h),
-    so [0, max h] brackets the root and no solve is needed at its ends. Brent's
-    method (scipy) narrows it; every inner solve starts from the previous
-    pressure. The search stops when |P(d) - pbar| / pbar <= rtol.
+    The mean pressure P(d) decreases from the complete-contact pressure at d -> 0+ to 0 at d = max(h), so
+    [0, max h] brackets the root; Brent's method (scipy) narrows it until |P(d) - pbar| / pbar <= rtol. If the
+    bracket reaches round-off in d first (near complete contact), the solution being affine in d while the
+    contact set stays, the closest solutions either side are interpolated to the load.
 
-    Near complete contact P changes so fast with d that the bracket can reach
-    round-off in d before the load is met. The solution is affine in d while
-    the contact set stays the same (K_CC p_C = h_C - d), so the search then
-    interpolates to the load between its closest solutions on either side of
-    it; the result is kept if it meets the tolerance on a fresh gap.
-
-    Parameters are those of :class:`~roughpetsc.solvers.bound_qp.BoundQP` (``control`` is "load"), and
-    ``inner``: the displacement-controlled solver to drive instead of a BoundQP of ``tao_type`` (an
-    object with BoundQP's ``solve(separation, pressure, history=...)``, ``separation``, ``max_seconds``,
-    ``name``, ``tao`` and ``destroy``).
+    ``inner``: the displacement-controlled solver to drive instead of a BoundQP of ``tao_type`` (with
+    BoundQP's ``solve(..., history=)``, ``separation``, ``max_seconds``, ``name``, ``tao``, ``destroy``).
     """
 
     def __init__(self, problem, control, tao_type, settings, max_evaluations=100, inner=None):
@@ -47,7 +36,6 @@ class RootFind(Backend):
 
     @property
     def tao(self):
-        """The TAO of the inner displacement-controlled solves."""
         return self.qp.tao
 
     def solve(self, pbar, pressure, guess):
@@ -132,11 +120,8 @@ class RootFind(Backend):
         return f"{state['stop']} ({', '.join(notes)})"
 
     def _interpolate(self, pbar, pressure, state):
-        """Replace ``pressure`` by the interpolation to the load of the solutions either side of it.
-
-        Returns True when the interpolated pressure meets the tolerance on a fresh gap (one operator
-        application) and has been put in ``pressure`` and ``state["separation"]``.
-        """
+        """Replace ``pressure`` by the interpolation to the load of the solutions either side of it, if that
+        meets the tolerance on a fresh gap (then True)."""
         problem = self.problem
         (d_above, mean_above), (d_below, mean_below) = state["above"], state["below"]
         t = (pbar - mean_below) / (mean_above - mean_below)

@@ -1,19 +1,9 @@
 """The one stopping rule of every solver backend: tolerance, fresh confirmation, limits, stagnation, best iterate.
 
-Every backend of :mod:`roughpetsc.solvers` (TAO's bound types through their convergence test, Polonsky-Keer
-and the gap CG as TAO ``python`` types, the ALMMs) decides when to stop with a :class:`Watch` on one
-:class:`StoppingRule`:
-
-* converged: the natural KKT residual (docs/conventions.md) and, where a load or a mean gap is prescribed,
-  its error are at most ``rtol``; a backend that updates its gradient instead of computing it afresh
-  must confirm on a fresh one first (the verdict ``CONFIRM``);
-* the iteration limit (``-tao_max_it``, :data:`DEFAULT_MAX_IT` by default), the time limit
-  (``-solve_max_time``) or a request to stop (Ctrl-C, :mod:`roughpetsc.interrupts`), decided
-  collectively so that every rank leaves at the same iteration;
-* stagnation: no new best residual for :data:`STAGNATION_ITERATIONS` iterations (round-off bounds the
-  residual from below; CG then wanders).
-
-A stop short of the tolerance names its reason and the best residual reached (:func:`describe_stop`).
+Every backend decides when to stop with a :class:`Watch` on one :class:`StoppingRule`: converged when the
+natural KKT residual (docs/conventions.md) and the error of a prescribed load or mean gap are at most ``rtol``
+(on a fresh gradient); else the iteration limit, the time limit or Ctrl-C (decided collectively), or
+stagnation. A stop short of the tolerance names its reason and the best residual (:func:`describe_stop`).
 """
 
 from dataclasses import dataclass
@@ -55,8 +45,7 @@ def max_seconds(prefix=None):
 class History:
     """Residual history of one solve: iteration, natural residual, operator applications, seconds.
 
-    The problem's ``progress`` callable, if set, is called as ``progress(iteration, natural, seconds)``
-    with every row that any solver records (the command line's progress line on a terminal).
+    Each row is also passed to the problem's ``progress(iteration, natural, seconds)``, if set.
     """
 
     def __init__(self, problem):
@@ -79,12 +68,9 @@ class History:
         self.rows.extend((offset + row[0], *row[1:]) for row in rows)
 
     def out_of_time(self, max_seconds):
-        """True when ``max_seconds`` (> 0) have passed since the history started (``-solve_max_time``), or
-        when a stop was requested on any rank (the problem's ``stop_requested``, Ctrl-C).
+        """True when ``max_seconds`` (> 0) have passed since the start, or a stop was requested on any rank.
 
-        Collective when ``max_seconds > 0`` or a stop can be requested: rank 0's clock decides for
-        every rank, as ranks whose clocks disagreed at the limit would leave the solve by different
-        iterations and hang, and a request on any rank stops them all.
+        Collective: rank 0's clock decides for every rank (ranks leaving at different iterations would hang).
         """
         timed = max_seconds > 0
         if not timed and self.stop_requested is None:
@@ -99,17 +85,8 @@ class History:
 
 @dataclass(frozen=True)
 class StoppingRule:
-    """When a solve stops; one per solver, shared by its backends.
-
-    Attributes
-    ----------
-    rtol : float
-        Tolerance on the natural KKT residual and on the error of the prescribed load or mean gap.
-    max_seconds : float
-        Seconds after which a solve stops (0: no limit), ``-solve_max_time``.
-    stagnation : int
-        Iterations without a new best residual after which a solve stops.
-    """
+    """When a solve stops: tolerance ``rtol`` on the natural residual and load error, ``max_seconds``
+    (``-solve_max_time``, 0: no limit), ``stagnation`` iterations without a new best residual."""
 
     rtol: float
     max_seconds: float = 0.0
@@ -145,16 +122,14 @@ class Watch:
     Attributes
     ----------
     best_natural : float
-        The lowest merit seen: the natural residual, or the larger of it and the load error where a
-        load is prescribed (an iterate with the wrong load is not close to the solution).
+        The lowest merit seen: the natural residual, or the larger of it and the load error.
     improved : bool
-        Whether the last :meth:`assess` found a new best (the backend may then keep a copy).
+        Whether the last :meth:`assess` found a new best.
     stopped_by : str or None
         ``"time limit"`` or ``"stagnation"`` when the watch ended the solve so.
     inner_eta : float
-        An inner solve of an outer iteration on the load (an augmented Lagrangian) is done once its natural
-        residual is at most ``inner_eta`` times its load error (``INNER_DONE``); 0: every solve is solved to
-        the tolerance.
+        An inner solve of an augmented Lagrangian is done (``INNER_DONE``) once its natural residual is at
+        most ``inner_eta`` times its load error; 0: solved to the tolerance.
     """
 
     def __init__(self, rule, history, max_iterations=DEFAULT_MAX_IT):
@@ -174,8 +149,7 @@ class Watch:
     def assess(self, iteration, natural, load_error=None, fresh=True, confirm=True):
         """The verdict on an iterate with this residual (and load error); records it unless it must be confirmed.
 
-        ``fresh``: the residual comes from a freshly computed gradient. A converged residual on an
-        updated one asks for confirmation (``CONFIRM``, nothing recorded) when ``confirm`` is True.
+        A converged residual on an updated (not ``fresh``) gradient returns ``CONFIRM`` when ``confirm``.
         """
         self.improved = False
         merit = natural if load_error is None else max(natural, load_error)
@@ -208,11 +182,8 @@ class Watch:
 class ConvergenceTest:
     """The :class:`Watch` as a TAO convergence test (``tao.setConvergenceTest``).
 
-    ``evaluate(tao)`` returns ``(natural, load_error, fresh)`` of the current iterate (load_error None
-    without a prescribed load). TAO's own verdict on its own residual (which differs by type) never ends
-    a solve early: a "converged" of TAO with a larger natural residual is turned back into "continue"
-    while iterations remain. ``keep_best(x)``, if given, is called with each new best iterate.
-    ``iteration_offset`` numbers the iterations of a solve restarted by its backend on from the first.
+    ``evaluate(tao)`` returns ``(natural, load_error, fresh)`` of the current iterate. TAO's own "converged"
+    never ends a solve early. ``keep_best(x)``, if given, is called with each new best iterate.
     """
 
     def __init__(self, watch, evaluate, keep_best=None, confirm=True):
@@ -241,11 +212,7 @@ class ConvergenceTest:
 
 
 def check_convergence(tao):
-    """Run the convergence test set on ``tao`` (a TAO of type ``python`` calls it once per iteration).
-
-    petsc4py 3.18 wraps neither ``TaoConverged`` nor ``Tao.checkConverged``; this calls the Python test
-    that ``tao.setConvergenceTest`` holds as petsc4py would, setting the reason it returns.
-    """
+    """Run the convergence test set on ``tao`` and set its reason (petsc4py 3.18 wraps no ``TaoConverged``)."""
     test, args, kwargs = tao.getConvergenceTest()
     reason = test(tao, *(args or ()), **(kwargs or {}))
     if reason is not None:
@@ -262,13 +229,8 @@ def reason_name(reason):
 
 
 def describe_stop(reason, watch, restarts=0, load_control=False, note=None):
-    """PETSc's reason name with what the watch stopped for and, short of the tolerance, the best residual.
-
-    ``reason`` is a TAO converged reason (int) or a reason name (str). A solve that ends short of the
-    tolerance says which residual it reached (and, after restarts, that this is the floor that restarting
-    could not lower), so a bare DIVERGED_LS_FAILURE is never the whole story. ``note`` says why a backend
-    gave up by itself (a failed line search of its own).
-    """
+    """PETSc's reason name (``reason``: int or name) with what the watch stopped for and, short of the
+    tolerance, the best residual reached; ``note`` says why a backend gave up by itself."""
     name = reason if isinstance(reason, str) else reason_name(reason)
     notes = [watch.stopped_by] if watch.stopped_by and name == "DIVERGED_USER" else []
     if note:
