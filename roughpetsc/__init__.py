@@ -1,10 +1,7 @@
 """roughpetsc: elastic contact of rough surfaces with PETSc/TAO.
 
-Data flow: options -> surface -> operator -> problem -> solver -> results -> files
-(docs/architecture.md). The statistical models (:mod:`roughpetsc.models`) depend on
-spectral moments only.
-
-The public API is the names of :data:`__all__`, imported from here::
+Data flow: options -> surface -> operator -> problem -> solver -> results -> files (docs/architecture.md).
+The public API is the names of :data:`__all__`::
 
     from . import ContactProblem, Grid, fractal, load_path
 
@@ -13,14 +10,9 @@ The public API is the names of :data:`__all__`, imported from here::
     for result in load_path(problem, pstars=[0.1, 0.5, 1.0]):
         print(result.pstar, result.A, result.kkt.natural)
 
-Every name is imported on first use (PEP 562 ``__getattr__``): ``import roughpetsc`` loads
-neither numpy nor PETSc, so the command line can hand PETSc its options
-(``petsc4py.init(argv)``) before anything imports ``petsc4py.PETSc``. Names of the surface,
-statistics and model parts never import PETSc; ``ContactProblem``, ``Solver`` and
-``load_path`` do (call ``petsc4py.init(args)`` first to give PETSc options).
-
-One thread per MPI rank: the BLAS and OpenMP pools are limited to one thread before numpy loads them,
-unless the environment says otherwise (docs/runtime.md).
+Every name is imported on first use (:mod:`roughpetsc.lazy`); ``ContactProblem``, ``Solver`` and ``load_path``
+import PETSc (call ``petsc4py.init(args)`` first to give PETSc options). BLAS and OpenMP get one thread per
+rank unless the environment says otherwise (docs/runtime.md).
 """
 
 import os

@@ -1,7 +1,6 @@
 """Package names imported on first use (PEP 562), so that importing a package loads neither numpy nor PETSc.
 
-The command line hands PETSc its options (``petsc4py.init(argv)``) before anything imports
-``petsc4py.PETSc``; every package of roughpetsc therefore exports its public names lazily.
+The command line hands PETSc its options (``petsc4py.init(argv)``) before anything imports ``petsc4py.PETSc``.
 """
 
 import importlib
@@ -10,9 +9,8 @@ import importlib
 def exports(package, modules, submodules=(), renamed=None):
     """``(__getattr__, __dir__, __all__)`` of ``package`` for ``modules`` = ``{module: "name name ..."}``.
 
-    ``module`` is relative to ``package``, each name exported as that module calls it; ``renamed`` =
-    ``{public name: (module, name)}`` exports a name under another; ``submodules`` are subpackages returned as
-    modules.
+    ``module`` is relative to ``package``; ``renamed`` = ``{public name: (module, name)}``; ``submodules`` are
+    subpackages returned as modules.
     """
     table = {name: (module, name) for module, names in modules.items() for name in names.split()}
     table.update(renamed or {})

@@ -36,15 +36,9 @@ def allmax(comm, values):
 
 
 def block_split(count, size):
-    """Balanced blocks of ``count`` items over ``size`` ranks, the extra items on the first ranks.
+    """``(starts, counts)`` of ``count`` items over ``size`` ranks, as PETSc's ``PetscSplitOwnership``.
 
-    The same split as PETSc's ``PetscSplitOwnership`` (``PETSC_DECIDE``):
-    rank ``r`` gets ``count // size + (r < count % size)`` items.
-
-    Returns
-    -------
-    starts, counts : ndarray of int, shape (size,)
-        First item and number of items of each rank.
+    Rank ``r`` gets ``count // size + (r < count % size)`` items.
     """
     counts = np.full(size, count // size, dtype=int)
     counts[: count % size] += 1
@@ -53,13 +47,7 @@ def block_split(count, size):
 
 
 def row_split(n0, size):
-    """The real-space row blocks of a grid of ``n0`` rows on ``size`` ranks: ``(starts, counts)``.
-
-    Raises
-    ------
-    ParameterError
-        (parameter ``n0``) if a rank would own no row (more ranks than rows).
-    """
+    """The row blocks ``(starts, counts)`` of ``n0`` rows on ``size`` ranks; ParameterError if a rank gets none."""
     if n0 < size:
         raise ParameterError("n0", f"the grid has {n0} row(s), fewer than the {size} MPI ranks "
                                    "that share them (every rank needs at least one row)")
@@ -75,10 +63,7 @@ def gather_rows(comm, local):
 
 
 def next_rank_first_row(comm, rows):
-    """The first row of the next rank (periodically): the neighbour below this rank's last row.
-
-    Every rank owns at least one row (:func:`roughpetsc.slab.row_split`), however unevenly they are shared.
-    """
+    """The first row of the next rank (periodically): the neighbour below this rank's last row."""
     size, rank = comm.Get_size(), comm.Get_rank()
     if size == 1:
         return rows[0]

@@ -1,7 +1,6 @@
 """The command line of adhesive contact (``-adhesion`` in ``-mode solve``): its options, checks and header.
 
-The physics is :mod:`roughpetsc.interaction` (the laws) and :mod:`roughpetsc.adhesive` (the problem and
-its solver); this module only turns options into them and refuses what cannot be combined yet.
+The physics is in :mod:`roughpetsc.contact.laws` and :mod:`roughpetsc.contact.adhesive`.
 """
 
 from ..errors import UserError
@@ -23,10 +22,8 @@ PARAMETERS = ("adhesion_work", "adhesion_stress", "adhesion_range")
 def read_law(values, given):
     """The law of ``-adhesion`` from the option values (None for none), each parameter as the user gave it.
 
-    ``given`` is the set of option names given. A parameter of no law (no ``-adhesion``), one the law
-    does not take (``-adhesion_stress`` of the exponential law) and ``-adhesion_range`` with
-    ``-adhesion_stress`` (two settings of the Dugdale range) are refused; a missing or bad one is
-    refused by :func:`roughpetsc.interaction.make_law`, quoting the value given.
+    ``given``: the option names given. Refused: parameters without a law, one the law does not take, both
+    Dugdale ranges; a missing or bad value by :func:`roughpetsc.contact.laws.make_law`.
     """
     from ..contact.laws import make_law
 
@@ -47,13 +44,14 @@ def read_law(values, given):
 def check(settings):
     """Refuse, by option name and before any work, what the command line cannot do with adhesion.
 
-    The solver (``-tao_type``), the boundary and the hardness are checked where the adhesive problem and its
-    solver are made (:class:`roughpetsc.contact.AdhesiveProblem`, the registry of solvers).
+    The solver, the boundary and the hardness are checked where the adhesive problem and its solver are made.
     """
     if settings.control != "displacement":
         raise UserError(f"-{settings.load_option}: adhesive contact is solved under displacement control (it jumps "
                         "in and out of contact under load control); prescribe -gbar or -gbar_list")
-    for refused, given, why in (("resume", settings.resume, "a resumed path restarts from its saved pressure; the adhesive problem's unknown is the gap"),
+    for refused, given, why in (("resume", settings.resume,
+                                 "a resumed path restarts from its saved pressure; the adhesive problem's unknown is "
+                                 "the gap"),
                                 ("stress_depths", settings.stress_depths,
                                  "the stresses are those of a contact pressure, not of adhesive tractions")):
         if given:
@@ -61,10 +59,7 @@ def check(settings):
 
 
 def summary(law, statistics, E_star):
-    """The law, its parameters and Tabor's parameter for a run's summary (``{"law": "none"}`` without one).
-
-    The radius of Tabor's parameter is the mean summit radius of :func:`roughpetsc.adhesive.summit_radius`.
-    """
+    """The law, its parameters and Tabor's parameter (of the mean summit radius) for a run's summary."""
     from ..contact.adhesive import summit_radius
     from ..contact.laws import tabor_parameter
 
@@ -82,11 +77,8 @@ def header(law, summary):
 
 
 def close_cycle(record, say):
-    """A path that returns to its first mean gap is a cycle: its dissipated energy into the summary, and said.
-
-    The energy per unit area -closed integral of pbar dgbar (:func:`roughpetsc.adhesive.dissipated_energy`),
-    pressure x length units; nothing for a path that does not return.
-    """
+    """A path back at its first mean gap is a cycle: its dissipated energy per unit area (pressure x length) into
+    the summary, and said."""
     from ..contact.adhesive import dissipated_energy
 
     steps = record.steps

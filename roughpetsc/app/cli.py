@@ -4,9 +4,8 @@
     mpiexec -n 2 python -m roughpetsc -tao_type bqnls     # load control: BQNLS in an augmented Lagrangian
     python -m roughpetsc -pstar_list 0.1,0.5,1 -json out.json -output out.h5
 
-Exit status: 0 success, 2 bad input (one message, no traceback, no output file), 3 a solve did not converge
-(reported as such; files are written and flag it), 130 interrupted by Ctrl-C or SIGTERM (the finished steps are
-written; -resume continues).
+Exit status: 0 success, 2 bad input (one message, no output file), 3 a solve did not converge (files flag it),
+130 interrupted by Ctrl-C or SIGTERM (the finished steps are written; -resume continues).
 """
 
 from contextlib import contextmanager
@@ -24,16 +23,12 @@ from .presets import PRESET_FOLDERS, ROOT, preset_names
 from .terminal import launcher_rank
 
 # The modes of -mode, in -help order. Each module has OPTIONS (its -help table) and run(options, comm), which
-# does the whole mode (the check that every option was used included) and returns the exit status, or its
-# result (status 0). A new mode is one module and one line here.
+# does the whole mode and returns the exit status, or its result (status 0).
 MODES = {"solve": solve_mode, "stats": stats_mode, "models": models_mode, "ensemble": ensemble}
 
 
 def all_options():
-    """``{name: default}`` of every option of roughpetsc (general, surface, each mode's, the solvers').
-
-    The solvers' tables come with their modules: call it once PETSc is initialised.
-    """
+    """``{name: default}`` of every option of roughpetsc (the solvers' too: call it once PETSc is initialised)."""
     from .surface_options import SURFACE_OPTIONS
 
     table = GENERAL_OPTIONS + SURFACE_OPTIONS + [option for module in MODES.values() for option in module.OPTIONS]
@@ -70,10 +65,9 @@ def print_help():
 
 @contextmanager
 def held_output(hold):
-    """Inside the block, what is written to file descriptor 1 (C's stdout too) is held, then written after it.
+    """Hold what is written to file descriptor 1 (C's stdout too) in the block, and print it after our -help.
 
-    PETSc prints its own -help while it is initialised; ours comes first, and needs the solvers' option
-    tables, whose modules import PETSc: PETSc's lines are held until ours are printed.
+    PETSc prints its -help while it is initialised, which ours needs (the solvers' tables import PETSc).
     """
     if not hold:
         yield
@@ -102,11 +96,8 @@ def held_output(hold):
 def resolve_presets(argv):
     """``argv`` with each ``-options_file PATH`` not found here resolved against :data:`ROOT`.
 
-    PETSc reads the files when it is initialised, so this runs before; a preset named from another folder
-    (``-options_file solvers/pk.opts``) or by its bare name (``-options_file pk``) is found in the repository.
-    Returns ``(argv, message)``: a file found nowhere, or one that is not an options file
-    (:func:`options_file_error`), is dropped from ``argv`` and ``message`` names it (raised once PETSc can report
-    it on rank 0).
+    Runs before PETSc reads the files; finds ``solvers/pk.opts`` or the bare ``pk``. Returns ``(argv, message)``:
+    a file found nowhere or not an options file is dropped and ``message`` names it (raised once PETSc runs).
     """
     resolved, message = list(argv[:1]), None
     items = iter(argv[1:])
@@ -130,8 +121,7 @@ def resolve_presets(argv):
 def options_file_error(path, found):
     """Why ``-options_file path`` (found at ``found``, or None) cannot be given to PETSc, or None if it can.
 
-    PETSc stops with an error dump on a file whose lines do not begin with an option; each line must
-    be blank, a ``#`` comment, ``-name [value]`` or ``alias -new -old``.
+    PETSc dumps an error on a line that is not blank, a ``#`` comment, ``-name [value]`` or ``alias -new -old``.
     """
     if not path:
         return "-options_file: give a file name"
@@ -172,9 +162,8 @@ def available_memory():
 def check_memory(reader, comm, mode):
     """Refuse, before anything is allocated, a generated surface too large for this machine's memory.
 
-    The estimate is :data:`PEAK_BYTES_PER_POINT` per grid point held by a rank (a slab of the grid in a solve, a
-    whole surface per rank in stats, a slab per group in an ensemble), summed over the ranks of this host. Surfaces
-    read from a file are not estimated (reading it is the test).
+    :data:`PEAK_BYTES_PER_POINT` per grid point a rank holds, summed over the ranks of this host; surfaces read
+    from a file are not estimated.
     """
     from mpi4py import MPI
 
@@ -197,8 +186,7 @@ def check_memory(reader, comm, mode):
 
 
 def hide_unused_petsc_stages():
-    """-log_view: PETSc 3.18 registers a stage PCMPI (its MPI linear-solver server, which roughpetsc never starts)
-    that -log_view lists, empty, as an anonymous stage 'Unknown'; it is hidden, so every stage shown is named."""
+    """-log_view: hide PETSc's never-used stage PCMPI, which it lists as an empty stage 'Unknown'."""
     from petsc4py import PETSc
 
     PETSc.Log.Stage("PCMPI").visible = False
@@ -234,8 +222,7 @@ def run_command_line(argv=None):
     argv, preset_error = resolve_presets(sys.argv if argv is None else argv)
     show_help = any(item in ("-help", "--help") for item in argv[1:])
     if show_help:
-        # Help piped into `head` or `less` ends quietly when the reader stops, as any Unix tool does,
-        # instead of in PETSc's SIGPIPE handler.
+        # Help piped into `head` ends quietly, not in PETSc's SIGPIPE handler.
         signal.signal(signal.SIGPIPE, signal.SIG_DFL)
         argv = [*argv, "-no_signal_handler"]
     version = any(item in ("-version", "--version") for item in argv[1:])

@@ -14,11 +14,10 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 class StopRequests:
-    """Context manager: inside it SIGINT and SIGTERM set :meth:`is_set` instead of raising.
+    """Context manager: inside it SIGINT and SIGTERM set :meth:`is_set` instead of raising; a second raises.
 
-    The handlers in place before are restored on exit. A second signal inside the block raises
-    ``KeyboardInterrupt``. ``announcement``, once set, is called once, at the first request, from a
-    thread that does not wait for the main one (:meth:`announce_once`).
+    ``announcement``, once set, is called once at the first request, from a thread that does not wait for the
+    main one.
     """
 
     def __init__(self):
@@ -58,8 +57,7 @@ class StopRequests:
                 self.announcement()
 
     def request_stop(self, announcement=None):
-        """Record a stop request (a signal, or a stop agreed with the other ranks, :func:`agreed`) and announce
-        it (with ``announcement`` if none was set), unless it was announced already."""
+        """Record a stop request and announce it once (with ``announcement`` if none was set)."""
         with self.lock:
             self.requested = True
             self.announcement = self.announcement or announcement
@@ -68,9 +66,8 @@ class StopRequests:
     def replace_unless_stopped(self, replacements, then=None):
         """Rename finished temporaries over their files and run ``then()``, unless a stop was requested.
 
-        ``replacements``: :class:`roughpetsc.store.outputs.atomic_path` objects whose temporaries
-        are written (``deferred``). A request comes wholly before (the temporaries are removed, the
-        files stay as they were) or wholly after. Returns True if the files were replaced.
+        ``replacements``: deferred :class:`roughpetsc.store.outputs.atomic_path` objects. A request comes wholly
+        before (the temporaries are removed) or wholly after. Returns True if the files were replaced.
         """
         try:
             with self.lock:

@@ -1,8 +1,4 @@
-"""``-mode models``: curves of every statistical model to JSON and PNG.
-
-Options are read only through ``PETSc.Options`` getters so that PETSc's
-``-options_left`` reports unused or misspelled ones.
-"""
+"""``-mode models``: curves of every statistical model to JSON and PNG."""
 
 from dataclasses import make_dataclass
 import json
@@ -68,7 +64,8 @@ def _validate(o):
 
 def compute(o):
     """All curves as a plain dict (lists), dimensionless as in roughpetsc.models."""
-    from ..models import ALPHA_P_TABLE_8_3, COMPLETE_MODELS, EARLY_MODELS, TABLE_8_4, complete, curvefit_area, early, persson_area, persson_gap
+    from ..models import (ALPHA_P_TABLE_8_3, COMPLETE_MODELS, EARLY_MODELS, TABLE_8_4, complete, curvefit_area, early,
+                          persson_area, persson_gap)
     ah, ap, n = o.models_alpha_h, o.models_alpha_p, o.models_n
     d = np.linspace(o.models_dmax, 0.0, n)
     p = np.linspace(0.0, o.models_pmax, n)
@@ -118,11 +115,7 @@ def plot(curves, path):
 
 
 def run(options, comm):
-    """Entry point of ``python -m roughpetsc -mode models``.
-
-    The work is done on rank 0; its errors (files that cannot be written) are
-    raised on every rank. Returns the curves on rank 0, None elsewhere.
-    """
+    """``-mode models``, worked on rank 0 (its errors raised on every rank); the curves on rank 0, None elsewhere."""
     o = read_settings(options)
     on_root(comm, check_outputs, [("models_json", o.models_json), ("models_plot", o.models_plot)],
             options.getBool("overwrite", False))

@@ -21,11 +21,7 @@ PETSC4PY_STRING_BUFFER = 1024
 
 
 class Reader:
-    """Typed reads from the options database that name the option on bad values, with the getters of
-    ``petsc4py.PETSc.Options`` (so that the readers of option tables take either).
-
-    Strings are read whole, whatever their length (:meth:`getString`); lists are read by :meth:`reals`.
-    """
+    """``petsc4py.PETSc.Options``'s getters naming the option on bad values; strings whole, lists by :meth:`reals`."""
 
     def __init__(self, database=None):
         self.database = database or PETSc.Options()
@@ -63,9 +59,8 @@ class Reader:
 def whole_string(name, text, prefix=None):
     """``text``, the value of ``-name`` (options prefix ``prefix``) as petsc4py read it, completed if cut.
 
-    petsc4py 3.18 reads at most 1023 characters (:data:`PETSC4PY_STRING_BUFFER`); a value of that length
-    is read again through ``PetscOptionsGetString`` with a buffer as long as it needs. Where the PETSc
-    library cannot be called, a value that may have been cut is refused rather than used cut.
+    A value of petsc4py's 1023 characters is read again through ``PetscOptionsGetString`` with a buffer long
+    enough; where the PETSc library cannot be called, it is refused rather than used cut.
     """
     if text is None or len(text.encode()) < PETSC4PY_STRING_BUFFER - 1:
         return text
@@ -140,10 +135,8 @@ def check_names(known_names):
 def check_values_given(defaults):
     """Refuse an option of ours given without a value, naming it.
 
-    ``defaults`` maps each of our option names to its default, whose type is the option's. PETSc keeps
-    an option given without a value (``-gbar`` alone, ``-output -json x``, ``-surface_file ""``, a bare
-    line in an options file) as set with no value, and its getters then return the caller's default: a
-    silent default in place of the value meant. Only a switch (a bool option) stands alone.
+    ``defaults``: our option names and defaults. PETSc's getters would silently return the default for an
+    option given without a value (``-gbar`` alone, ``-output -json x``); only a bool option stands alone.
     """
     bare = [name for name, value in PETSc.Options().getAll().items()
             if name in defaults and value is None and not isinstance(defaults[name], bool)]
@@ -159,11 +152,8 @@ def check_values_given(defaults):
 def check_unused(ignore=(), final=True, unusable=()):
     """Raise :class:`UserError` if an option was given that nothing used (a misspelling, say).
 
-    With ``final=False`` (before a solve) options that PETSc reads only during
-    or after the solve (:func:`read_late`) are skipped, so a misspelling fails
-    before the work and a late option is checked by the final call after it.
-    ``unusable`` names options that were read but that the run cannot use (the line search or KSP of a
-    solver that has none, :func:`given_but_unusable`): reported like the unused ones.
+    With ``final=False`` (before a solve) options PETSc reads only during or after a solve (:func:`read_late`) are
+    skipped. ``unusable``: options read but of no use to this run, reported like the unused ones.
     """
     unused = unused_options()
     if unused is None:  # cannot be checked here: unused_options has said so

@@ -1,9 +1,6 @@
 """Figures of a solve (``-plot PATH.png``): pressure and gap maps of the last step, A* against p* of a load path,
-the mean pressure against the mean gap of an adhesive path (its approach and retraction).
-
-Drawn with matplotlib's Agg canvas through :class:`matplotlib.figure.Figure`
-(no pyplot, no display, no global backend state); the format follows the
-file's suffix.
+the mean pressure against the mean gap of an adhesive path. Drawn through :class:`matplotlib.figure.Figure`
+(no pyplot, no global backend state); the format follows the file's suffix.
 """
 
 import os
@@ -12,21 +9,9 @@ import os
 def plot_solution(path, grid, pressure, gap, steps, adhesion=None):
     """Write the figure of a solve to ``path`` (atomically).
 
-    Parameters
-    ----------
-    path : str
-        The figure file; its suffix names the format (png, pdf, svg, ...).
-    grid : surfaces.Grid
-        The cell (length units), for the axes of the maps.
-    pressure, gap : ndarray (n0, n1)
-        Fields of the last step, pressure and length units.
-    steps : list of dict
-        Step summaries (``pstar``, ``A``, ``A_corrected``, ``pbar``, ``gbar``); with more than one,
-        a third panel shows the contact area against the load, or, for an adhesive path, the mean
-        pressure against the mean gap.
-    adhesion : dict or None
-        The run's adhesion summary (``law``, ``dissipated_energy`` of a closed cycle) for an adhesive
-        path, else None.
+    ``pressure``, ``gap``: the last step's fields (pressure and length units). ``steps``: the step summaries;
+    with more than one, a third panel shows A* against p*, or with ``adhesion`` (the run's adhesion summary)
+    pbar against gbar.
     """
     from matplotlib.figure import Figure
     import numpy as np

@@ -1,9 +1,7 @@
 """The preset files: ``solvers/*.opts`` (solver settings) and ``options/*.opts`` (surface groups), package data.
 
-A preset is a PETSc options file, one ``-name value`` a line, ``#`` comments. The command line
-passes them to PETSc (``-options_file``); Python code (the studies, the API) reads them with
-:func:`read_opts`, so a surface group of Tables 7.1/8.1 of the dissertation is typed once, in its
-``options/groupNN.opts``. This module does not import PETSc.
+A preset is a PETSc options file; Python code reads it with :func:`read_opts`, so a surface group of Tables
+7.1/8.1 is typed once, in its ``options/groupNN.opts``. This module does not import PETSc.
 """
 
 import glob
@@ -40,11 +38,8 @@ def presets(folder):
 def fractal_group(number):
     """The fractal surface of group ``number`` (``options/groupNN.opts``), defaults filled in.
 
-    Returns
-    -------
-    dict with ``n`` (nodes per side), ``length`` (cell length along x, length units) and the
-    keywords ``k_l``, ``k_s`` [cycles/length], ``hurst``, ``m2`` of
-    :func:`roughpetsc.surfaces.fractal`.
+    ``{n, length, k_l, k_s, hurst, m2, generator}``: nodes per side, cell length along x (length units) and
+    the keywords of :func:`roughpetsc.surfaces.fractal` (k in cycles/length).
     """
     from .surface_options import FRACTAL_KEYWORDS, SURFACE_OPTIONS
 

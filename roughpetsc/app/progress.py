@@ -8,15 +8,12 @@ import numpy as np
 class Progress:
     """Prints where a running load step is, at most every ``interval`` seconds of wall time.
 
-    A line names the load step (:meth:`start_step`), the inner solve of the step (a root find on the
-    separation solves several problems in a row, each counting its iterations from 0; the augmented
-    Lagrangian of a TAO bound type under load control records each multiplier update at the iteration
-    it stopped, and counts on; a solve that is resumed to confirm its result is a second one), the
-    iteration, the natural residual and the seconds since the step began::
+    A line names the load step, the inner solve of the step (a root find or an augmented Lagrangian solves
+    several in a row), the iteration, the natural residual and the seconds since the step began::
 
           ... step 3 of 95 (pstar 0.02): inner solve 2, iteration 120, KKT natural 1.20e-05, 4.1 s
 
-    Nothing is printed for a step shorter than ``interval`` (each step prints its own line when it ends).
+    Nothing is printed for a step shorter than ``interval``.
     """
 
     def __init__(self, interval, stream):

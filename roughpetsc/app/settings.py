@@ -1,19 +1,9 @@
 """Option tables of the modes and the checks they share: one table feeds ``-help`` and the settings.
 
-A table is a list of ``(name, default, help)`` tuples; the option's type is its default's
-(``int``, ``float``, ``str``, ``bool``). ``roughpetsc.cli`` prints the tables for ``-help`` and
-knows every option name from them; :func:`read_table` reads a whole table from the options
-database, and each mode turns that into its frozen settings dataclass
-(:class:`roughpetsc.stats_mode.StatsSettings`, :class:`roughpetsc.ensemble.settings.EnsembleSettings`).
-
-:data:`GENERAL_OPTIONS` are every mode's; :data:`PARAMETER_OPTIONS` and :func:`user_message` are the one
-translation of a library :class:`~roughpetsc.errors.ParameterError` (a Python parameter, physical
-words) into the option that set it, for the command line and :func:`options_named`.
-
-The checks below are the one place for each: the KKT tolerance, the modulus E* (1.6), the FFT
-threads and planner effort, the random-surface options of an ensemble and the fractal parameters
-(7.1)-(7.2) with their defaults taken from :data:`roughpetsc.surface_options.SURFACE_OPTIONS`. They read
-options, so they raise :class:`~roughpetsc.errors.UserError` naming the option.
+A table is a list of ``(name, default, help)`` tuples, the option's type its default's; :func:`read_table` reads
+one, and each mode makes its frozen settings of it. :func:`user_message` turns a library
+:class:`~roughpetsc.errors.ParameterError` into a message naming the option that set the parameter
+(:data:`PARAMETER_OPTIONS`). The shared checks raise :class:`~roughpetsc.errors.UserError` naming the option.
 """
 
 from contextlib import contextmanager
@@ -49,20 +39,15 @@ PARAMETER_OPTIONS = {**{keyword: option for option, keyword in surface_options.F
                      "n1": "surface_N", "n0": "surface_N0/-surface_N", "length": "surface_L",
                      "kind": "surface_type", "heights": "surface_type", "path": "surface_file",
                      "amplitude": "surface_amplitude", "wavelength": "surface_wavelength", "radius": "surface_radius",
-                     "effort": "fft_effort", "detrend": "surface_detrend", "E_star": "E_star", "e_star": "E_star", "rtol": "kkt_rtol",
+                     "effort": "fft_effort", "detrend": "surface_detrend", "E_star": "E_star", "e_star": "E_star",
+                     "rtol": "kkt_rtol",
                      "tao_type": "tao_type", "pstar": "pstar", "pbar": "pbar", "gbar": "gbar",
                      "boundary": "boundary", "hardness": "hardness", "depths": "stress_depths", "nu": "nu",
                      **{name: name for name in ("adhesion", "adhesion_work", "adhesion_stress", "adhesion_range")}}
 
 
 def user_message(error):
-    """The one line that reports a bad input on the command line.
-
-    A :class:`UserError` names its option already and is given as it is. A library
-    :class:`ParameterError` names the Python parameter (``k_s``); the option the user typed
-    (``-surface_ks``, :data:`PARAMETER_OPTIONS`) prefixes its message, or the parameter itself if
-    no option sets it.
-    """
+    """The one line reporting a bad input: a :class:`ParameterError` prefixed by its option (else parameter)."""
     if not isinstance(error, ParameterError):
         return str(error)
     option = PARAMETER_OPTIONS.get(error.parameter)
@@ -71,8 +56,7 @@ def user_message(error):
 
 @contextmanager
 def options_named():
-    """Turn a :class:`ParameterError` of the library into a :class:`UserError` naming the option that set it
-    (:func:`user_message`)."""
+    """Turn a :class:`ParameterError` into a :class:`UserError` naming the option that set it."""
     try:
         yield
     except ParameterError as error:
@@ -80,10 +64,7 @@ def options_named():
 
 
 def read_table(options, table):
-    """``{name: value}`` of every option of ``table``, read with the getter of its type.
-
-    ``options`` is a ``petsc4py.PETSc.Options`` or a :class:`roughpetsc.options.Reader`.
-    """
+    """``{name: value}`` of ``table`` from ``options`` (PETSc.Options or a Reader), with its type's getter."""
     getters = {int: options.getInt, float: options.getReal, str: options.getString, bool: options.getBool}
     return {name: getters[type(default)](name, default) for name, default, _ in table}
 
@@ -117,10 +98,7 @@ def is_random_surface(options):
 
 
 def check_ensemble_surfaces(options, option, mode):
-    """An ensemble needs random surfaces whose seeds derive from ``-ensemble_seed`` (:mod:`roughpetsc.seeds`).
-
-    ``option`` names the option that asked for an ensemble (the message names it), ``mode`` the mode.
-    """
+    """Refuse an ensemble (asked for by ``-option``) of other than random surfaces seeded by ``-ensemble_seed``."""
     if not is_random_surface(options):
         raise UserError(f"-{option}: an ensemble needs random surfaces (-surface_type fractal, no -surface_file)")
     if options.hasName("surface_seed"):
@@ -131,8 +109,7 @@ def check_ensemble_surfaces(options, option, mode):
 def fractal_parameters(options):
     """The fractal surface of the options, checked: ``{"type", "N0", "N", "L", "kl", "ks", "H", "m2", "generator"}``.
 
-    Returns ``(grid, parameters)``. Defaults are those of :data:`roughpetsc.surface_options.SURFACE_OPTIONS`
-    (:func:`roughpetsc.surface_options.option_values`); ``L`` is the cell length along x.
+    Returns ``(grid, parameters)``, (7.1)-(7.2); ``L`` is the cell length along x.
     """
     given = surface_options.option_values(options, surface_options.TYPE_OPTIONS["fractal"])
     parameters = {"type": "fractal", "kl": given["surface_kl"], "ks": given["surface_ks"], "H": given["surface_H"],

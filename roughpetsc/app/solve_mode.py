@@ -1,9 +1,7 @@
 """``-mode solve``: one surface, a list of loads solved in order by one Solver, the files of the run.
 
-The option table :data:`OPTIONS` is what ``-help`` prints for the mode; its first part,
-:data:`SETTINGS_OPTIONS`, is read into the frozen :class:`SolveSettings` (with the general options
-of ``roughpetsc.cli``); the rest are read by the solvers themselves from the options database.
-This module imports PETSc only when it runs (``-help`` prints its table before PETSc starts).
+The loads, physics and :data:`SETTINGS_OPTIONS` are read into the frozen :class:`SolveSettings`; the solvers
+read their own options. PETSc is imported only when the mode runs (``-help`` prints before PETSc starts).
 """
 
 from dataclasses import fields, make_dataclass
@@ -16,7 +14,8 @@ import numpy as np
 from . import adhesion_options as adhesive_options
 from ..errors import UserError
 from .terminal import printer
-from .settings import FFT_EFFORT, FFT_THREADS, GENERAL_OPTIONS, KKT_RTOL, OUTPUT, QUIET, check_fft, check_modulus, check_rtol, options_named, read_table
+from .settings import (FFT_EFFORT, FFT_THREADS, GENERAL_OPTIONS, KKT_RTOL, OUTPUT, QUIET, check_fft, check_modulus,
+                       check_rtol, options_named, read_table)
 
 # Read by read_settings into SolveSettings (besides the loads -pstar, -pbar, -gbar, -pstar_list).
 SETTINGS_OPTIONS = [
@@ -75,10 +74,7 @@ OPTIONS = LOAD_OPTIONS + PHYSICS_OPTIONS + SETTINGS_OPTIONS
 
 
 def solver_options():
-    """The options of the solvers, declared next to their readers: the stopping rule's and each backend's.
-
-    Imports the solvers (and so PETSc): call it once PETSc is initialised.
-    """
+    """The options of the stopping rule and of each backend (imports PETSc: call it once PETSc is initialised)."""
     from ..solvers import option_tables, stopping
 
     return stopping.OPTIONS + [option for table in option_tables().values() for option in table]
@@ -131,10 +127,7 @@ def load_steps(reader):
 
 
 def read_settings(reader, general_options=GENERAL_OPTIONS):
-    """The :class:`SolveSettings` of the options database; ``general_options`` is the table of ``-E_star``, ...
-
-    Raises :class:`UserError` naming the option for a bad value.
-    """
+    """The :class:`SolveSettings` of the options database; :class:`UserError` naming the option for a bad value."""
     from ..store.path_record import OUTPUT_FIELDS
 
     steps, load_option = load_steps(reader)
@@ -165,7 +158,7 @@ def read_settings(reader, general_options=GENERAL_OPTIONS):
 
 
 def read_physics(reader):
-    """The values of :data:`PHYSICS_OPTIONS`, checked: ``boundary``, ``hardness`` (None: no cap), ``stress_depths``, ``nu``."""
+    """The values of :data:`PHYSICS_OPTIONS`, checked (``hardness`` None: no cap)."""
     from ..contact.problem import BOUNDARIES
     from ..elastic.stresses import check_depths, check_poisson
 
@@ -188,8 +181,7 @@ def read_physics(reader):
 def check_files(settings, comm):
     """Refuse, on every rank, outputs that exist (without -overwrite), overwrite the input or cannot be written.
 
-    Under ``-resume`` the file of -output is meant to exist, and so is a -json summary that this load
-    path wrote (:func:`is_summary_of`): a resumed run rewrites both.
+    Under ``-resume`` the -output file and the -json summary of that load path are meant to exist.
     """
     from ..fft import plans as fftw
     from ..store import outputs as io
@@ -224,12 +216,8 @@ def is_summary_of(json_path, h5_path):
 
 
 class StepLines:
-    """The lines of finished steps, printed once the output files hold their step.
-
-    With ``-output`` or ``-json`` a step's line waits for the checkpoint that writes the step
-    (:func:`checkpoint`): a run interrupted at any moment has written every step it has printed.
-    Without output files a line is printed at once.
-    """
+    """The lines of finished steps: with ``hold`` (output files) each waits for the checkpoint that writes it,
+    so an interrupted run has written every step it printed."""
 
     def __init__(self, say, hold):
         self.say, self.hold, self.pending = say, hold, []
@@ -248,11 +236,7 @@ class StepLines:
 
 
 def progress_printer(settings, comm):
-    """The progress lines of a running step (:class:`roughpetsc.kkt.Progress`) on rank 0, or None.
-
-    ``-progress on`` or ``off`` decides; ``auto`` prints them when a person watches rank 0's output
-    (:func:`roughpetsc.terminal.watched`: a terminal, also behind mpiexec, never a pipe or a file).
-    """
+    """The progress lines of a running step on rank 0, or None (``-progress auto``: when a person watches)."""
     from .progress import Progress
     from .terminal import watched
 
@@ -266,9 +250,7 @@ def progress_printer(settings, comm):
 def run(reader, comm):
     """Solve the loads of the options on the surface of the options; the exit status (0, 3 or 130).
 
-    From the first check on, Ctrl-C and SIGTERM ask the run to stop (:mod:`roughpetsc.interrupts`):
-    every rank leaves the solve at the same iteration, the files keep every step whose line was
-    printed, and one line says so (exit status 130).
+    Ctrl-C and SIGTERM stop every rank at the same iteration; the files keep every step whose line was printed.
     """
     from .interrupts import StopRequests
 
@@ -279,10 +261,7 @@ def run(reader, comm):
 
 
 def build_problem(settings, reader, comm):
-    """``(grid, heights, problem, levelling)`` of the options: the surface, then the ContactProblem on every rank.
-
-    ``levelling``: the :class:`roughpetsc.files.Levelling` of a surface file, None for a generated surface.
-    """
+    """``(grid, heights, problem, levelling)`` of the options; ``levelling`` None for a generated surface."""
     from petsc4py import PETSc
 
     from ..fft import plans as fftw
@@ -323,7 +302,8 @@ def solve_settings(settings, reader, comm, requests):
         unusable = solver.unusable_options()
         check_unused(final=False, unusable=unusable)  # misspellings fail now; those read after a solve, then
         summary = {"grid": [grid.n0, grid.n1], "length": [grid.l0, grid.l1], "E_star": settings.E_star,
-                   "surface": statistics, "surface_parameters": dict(surface_options.parameters(reader), surface_L=grid.l1),
+                   "surface": statistics,
+                   "surface_parameters": dict(surface_options.parameters(reader), surface_L=grid.l1),
                    "sqrt_m0h": problem.sqrt_m0h, "sqrt_m0p": problem.sqrt_m0p,
                    "solver": solver.name, "control": settings.control, "kkt_rtol": settings.kkt_rtol,
                    "boundary": settings.boundary, "hardness": settings.hardness or 0.0,
@@ -433,10 +413,7 @@ def whole_last_fields(record, comm, distributed, settings):
 
 
 def record_stresses(settings, record, grid, fields):
-    """The subsurface stresses of the last step at ``settings.stress_depths`` into ``record`` (rank 0).
-
-    Returns the lines that report them.
-    """
+    """The subsurface stresses of the last step at ``settings.stress_depths`` into ``record`` (rank 0); their lines."""
     from ..elastic.stresses import free_stresses, periodic_stresses
 
     pressure = fields.get("pressure")
@@ -455,8 +432,7 @@ def record_stresses(settings, record, grid, fields):
 
 
 def plot_outputs(settings, record, grid, fields):
-    """The figure of the run (rank 0; a failure there is every rank's error, io.on_root). ``fields``: the last
-    step's whole fields."""
+    """The figure of the run on rank 0; ``fields``: the last step's whole fields."""
     from . import plots
 
     if settings.plot and not fields:  # every step taken from a file without fields
@@ -478,14 +454,9 @@ def step_line(step):
 def solve_path(settings, solver, record, comm, lines, requests, progress=None):
     """Solve the loads of ``settings.steps`` not yet in ``record``, recording each and checkpointing the files.
 
-    Each step's pressure and gap are gathered on rank 0 for the record when ``settings.gather_fields``, or kept
-    as this rank's rows when every rank writes its rows of the file (``record.first_row``). Every option must
-    have been used once the first solve is done (PETSc reads viewers and converged reasons during and after
-    TAOSolve); the check runs then, before any file is written.
-
-    Returns True when a stop was requested (``requests``, on any rank): the step that was running is
-    dropped, and nothing more is written. ``progress``: the :class:`roughpetsc.kkt.Progress` to tell
-    of each new step, or None.
+    Fields are gathered on rank 0 (``settings.gather_fields``) or kept as this rank's rows
+    (``record.first_row``). Unused options are refused after the first solve, before any file is written.
+    Returns True when a stop was requested on any rank: the running step is dropped, nothing more written.
     """
     from .interrupts import agreed
     from .options import check_unused
@@ -534,19 +505,15 @@ def solve_path(settings, solver, record, comm, lines, requests, progress=None):
 
 
 def checkpoint(settings, record, comm, requests):
-    """Rewrite the files (-output, -json) with the steps so far when it is time to; True if they were written.
-
-    Every rank takes part: a failed write stops them all. Rank 0's clock decides for all. After a stop
-    request (``requests``, :class:`roughpetsc.app.interrupts.StopRequests`) nothing is written.
-    """
+    """Rewrite -output and -json with the steps so far when rank 0's clock says so, not after a stop request;
+    True if they were written. Every rank takes part."""
     if not (settings.output or settings.json) or not comm.bcast(record.due() and not requests.is_set(), root=0):
         return False
     return write_files(settings, record, comm, requests)
 
 
 def write_files(settings, record, comm, requests):
-    """Write -output and -json with the steps so far, by every rank where each writes its rows of the fields,
-    else by rank 0; True on every rank if the files were replaced (not after a stop request, ``requests``)."""
+    """Write -output and -json with the steps so far (every rank its rows, else rank 0); True if replaced."""
     from ..store import outputs as io
 
     if record.first_row is not None:

@@ -60,9 +60,7 @@ class StatsSettings:
     psd_band: tuple = None
 
     def record(self):
-        """``{name: value}`` of the settings: the document's ``settings`` (``e_star``, ``fd_scheme``, ``psd`` and
-        ``psd_band`` are what :func:`surface_statistics` reads); ``psd_band`` as a list, empty for the default
-        of each surface (HDF5 attributes have no None)."""
+        """``{name: value}`` of the settings; ``psd_band`` as a list, empty for the default (HDF5 has no None)."""
         return dict(asdict(self), psd_band=list(self.psd_band or ()))
 
 
@@ -88,8 +86,8 @@ def read_settings(options):
 
 
 def psd_band(options, given):
-    """``-stats_psd_band`` as ``(k_min, k_max)``; that of a fractal surface of the options, or None (the fundamental
-    to the Nyquist wavenumber of each surface) when not given. Read only with ``-stats_psd``."""
+    """``-stats_psd_band`` as ``(k_min, k_max)``, else (k_l, k_s) of a fractal surface, else None (each surface's
+    default); read only with ``-stats_psd``."""
     if not given["stats_psd"]:
         return None
     from ..contact.loads import parse_reals
@@ -97,7 +95,8 @@ def psd_band(options, given):
     if options.hasName("stats_psd_band"):
         band = parse_reals(given["stats_psd_band"], "stats_psd_band")
         if len(band) != 2 or not (0 < band[0] < band[1] and np.isfinite(band[1])):
-            raise UserError(f"-stats_psd_band: give k_min,k_max with 0 < k_min < k_max, got '{given['stats_psd_band']}'")
+            raise UserError(f"-stats_psd_band: give k_min,k_max with 0 < k_min < k_max, "
+                            f"got '{given['stats_psd_band']}'")
         return tuple(band)
     if mode_settings.is_random_surface(options):
         _, surface = mode_settings.fractal_parameters(options)
@@ -134,8 +133,7 @@ def flatten_moments(label, moments):
 def field_summit_statistics(grid, field, moments, edges, label):
     """Scalars and histogram counts of the summits and heights of one field (``h`` or ``-p_c``).
 
-    ``moments`` are the isotropic finite-difference moments of ``field`` ({0, 2, 4: m_n}); they normalise heights
-    (sqrt(m0)) and curvatures (sqrt(m4)).
+    ``moments``: the isotropic finite-difference ``{0, 2, 4: m_n}`` of ``field``, normalising heights and curvatures.
     """
     summits = asperities.find_summits(grid, field)
     xi, kappa_m = asperities.normalised_summits(summits, moments[0], moments[4])
@@ -156,12 +154,10 @@ def field_summit_statistics(grid, field, moments, edges, label):
 def surface_statistics(grid, heights, settings, edges):
     """All per-surface quantities: ``(scalars, counts, psd)``.
 
-    ``scalars``: flat ``{name: float}`` with the directional and isotropic moments of h and p_c by finite
-    differences (``_fd``) and from the spectrum (``_spec``), bandwidths, summit counts and GW inputs (measured and
-    McCool's). ``counts``: ``{name: (bin counts, total)}`` of the dimensionless heights, summit heights and
-    curvatures of h and -p_c. With ``-stats_psd``: ``psd`` the sums of the
-    radially averaged PSD (:func:`roughpetsc.spectra.radial_psd_sums`), and the fit of (2.18)
-    (:func:`roughpetsc.spectra.fit_fractal_psd`) among the scalars (``psd_hurst``, ``psd_C``); else None.
+    ``scalars``: the moments of h and p_c by finite differences (``_fd``) and from the spectrum (``_spec``),
+    bandwidths, summit counts and GW inputs. ``counts``: ``{name: (bin counts, total)}`` of the dimensionless
+    heights, summit heights and curvatures. ``psd``: with ``-stats_psd`` the radial PSD sums (the fit of (2.18)
+    among the scalars), else None.
     """
     summary = spectra.surface_moment_summary(grid, heights, settings["e_star"], settings["fd_scheme"])
     scalars = {}
@@ -189,24 +185,19 @@ def surface_statistics(grid, heights, settings, edges):
 
 
 def default_psd_band(grid):
-    """The band of the PSD fit without -stats_psd_band for a surface that is not fractal: the fundamental
-    wavenumber to the Nyquist wavenumber of the coarser direction [cycles/length]."""
+    """The fundamental to the coarser direction's Nyquist wavenumber [cycles/length]: a non-fractal PSD fit band."""
     return spectra.radial_bin_width(grid), min(grid.n0 / grid.l0, grid.n1 / grid.l1) / 2.0
 
 
 # --- Ensemble over ranks
 
 def surface_seeds(settings):
-    """Seeds of the realisations in index order (:func:`roughpetsc.seeds.surface_seeds`); ``[None]`` for the
-    single surface of the options."""
+    """Seeds of the realisations in index order; ``[None]`` for the single surface of the options."""
     return [None] if settings.ensemble == 0 else seeds.surface_seeds(settings.ensemble_seed, settings.ensemble)
 
 
 def local_statistics(options, settings, seeds, edges, rank, size, levelling=None):
-    """Statistics of the surfaces dealt to this rank: list of ``(index, seed, scalars, counts, grid, psd)``.
-
-    ``levelling``: a list that receives the :class:`roughpetsc.files.Levelling` of a surface file.
-    """
+    """Statistics of this rank's surfaces: ``(index, seed, scalars, counts, grid, psd)``; ``levelling`` as notes."""
     results = []
     for index in range(rank, len(seeds), size):
         with mode_settings.options_named():
@@ -217,11 +208,9 @@ def local_statistics(options, settings, seeds, edges, rank, size, levelling=None
 
 
 def gather_in_seed_order(comm, results_or_error):
-    """Gather every rank's results (or the message of its error, a str) on rank 0 and sort them by surface
-    index; raise any rank's error as a :class:`UserError`.
+    """Every rank's results (or its error message, a str) on rank 0 in surface order, None elsewhere.
 
-    Returns the ordered list on rank 0 and None elsewhere; every rank raises the same :class:`UserError` if any
-    rank failed.
+    Every rank raises the same :class:`UserError` if any rank failed.
     """
     gathered = comm.gather(results_or_error, root=0)
     first_error = next((item for item in gathered if isinstance(item, str)), None) if comm.rank == 0 else None
@@ -286,11 +275,7 @@ def pdf_distances(summary):
 # --- Entry point
 
 def compute(options, comm, settings, surface):
-    """Compute the statistics on all ranks; the result document on rank 0, None elsewhere.
-
-    ``settings`` are :func:`read_settings` of ``options``, ``surface`` the surface options as read for the record
-    (:func:`roughpetsc.app.surface_options.parameters`).
-    """
+    """Compute the statistics on all ranks; the result document on rank 0, None elsewhere."""
     record = settings.record()
     realisation_seeds = surface_seeds(settings)
     edges = histogram_edges(settings.bin_width)
@@ -314,10 +299,7 @@ def compute(options, comm, settings, surface):
 
 
 def psd_document(grid, summary, band):
-    """The radially averaged PSD over the surfaces and the fit of (2.18), as written by ``-stats_psd``.
-
-    The fit is the mean over the surfaces of each one's H and C (:func:`roughpetsc.spectra.fit_fractal_psd`).
-    """
+    """The radially averaged PSD over the surfaces and the fit of (2.18): the mean of each surface's H and C."""
     k, psd, modes = spectra.radial_psd(grid, summary["psd"])
     hurst, amplitude = summary["mean"]["psd_hurst"], summary["mean"]["psd_C"]
     inside = (k >= band[0] * (1 - 1e-12)) & (k <= band[1] * (1 + 1e-12))
@@ -332,15 +314,7 @@ def psd_document(grid, summary, band):
 def run(options, comm):
     """The ``stats`` mode: compute, print on rank 0 and write the requested files.
 
-    Parameters
-    ----------
-    options : petsc4py.PETSc.Options
-    comm : mpi4py.MPI.Comm
-
-    Returns
-    -------
-    The result document (dict) on rank 0, None on the other ranks.
-    Raises :class:`UserError` on bad input (on every rank).
+    Returns the result document on rank 0, None elsewhere; :class:`UserError` on every rank for bad input.
     """
     from .options import check_unused  # imports PETSc: only once the command line has initialised it
 

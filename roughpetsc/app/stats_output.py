@@ -1,9 +1,7 @@
 """What ``-mode stats`` prints and writes: the result document, the report table, the PDF plots, the files.
 
-The document (:func:`result_document`) is a plain dict of numbers, strings and lists: rank 0 prints
-:func:`format_report` of it and writes it as JSON (:func:`roughpetsc.io.write_json`), as HDF5
-(:func:`roughpetsc.store.stats_file.write`) and as PNG plots of the pooled PDFs against their closed
-forms (:func:`plot_pdfs`). The statistics themselves are computed in :mod:`roughpetsc.stats_mode`.
+Rank 0 prints the document (:func:`result_document`, a plain dict) and writes it as JSON, HDF5 and PNG plots of
+the pooled PDFs against their closed forms; the statistics are computed in :mod:`roughpetsc.app.stats_mode`.
 """
 
 import numpy as np
@@ -46,8 +44,7 @@ def result_document(summary, settings, surface, closed, distances, seeds, grid):
         "conventions": "moments m_n0 (x) and m_0n (y) in [field]^2/length^n, w = 2 pi k; *_fd: finite "
                        "differences (7.6)/(7.7), *_spec: discrete spectrum (2.12); m<n>h_fd without _x/_y is "
                        "the x-y mean (the dissertation's 'Num', Table 7.7); p = pressure surface p_c (2.47) with E* = "
-                       "E_star; "
-                       "std is the sample std over realisations (ddof=1)",
+                       "E_star; std is the sample std over realisations (ddof=1)",
     }
 
 
@@ -144,8 +141,7 @@ def report(document):
 
 
 def write_psd(path, psd):
-    """The radially averaged PSD and its fit as CSV (atomically): a commented header with the fit, then
-    ``k, psd, modes, fit`` per annulus (fit empty outside the band)."""
+    """The radially averaged PSD and its fit as CSV (atomically): ``k, psd, modes, fit`` (empty outside the band)."""
     with atomic_path(path) as temporary, open(temporary, "w") as handle:
         handle.write(f"# radially averaged PSD S(k), [height]^2 length^2, annuli of width {psd['k'][0]:g} "
                      "cycles/length\n")

@@ -6,9 +6,8 @@ from ..surface.generators import DEFAULT_GENERATOR, bisinusoid, fractal, hertz_s
 from ..surface.grid import square_grid
 
 
-# Options of the surface, with defaults: the embedded default is a surface of
-# group #1 of Table 7.1, (k_l, k_s, H) = (16, 64, 0.8), m2 = 2e-4, N = 256.
-# The one place of these defaults: from_options, parameters and roughpetsc.presets read them here.
+# The one place of the surface defaults: a surface of group #1 of Table 7.1, (k_l, k_s, H) = (16, 64, 0.8),
+# m2 = 2e-4, N = 256.
 SURFACE_OPTIONS = [
     ("surface_type", "fractal", "fractal | bisinusoid | wave | sphere (an error with -surface_file)"),
     ("surface_file", "", "read heights from PATH: .npy, a text or CSV height matrix or x y z point list on a grid, "
@@ -24,8 +23,9 @@ SURFACE_OPTIONS = [
     ("surface_H", 0.8, "fractal: Hurst exponent H in (0, 1)"),
     ("surface_m2", 2e-4, "fractal: prescribed m2^h (mean square slope along x), sets C by (7.1)"),
     ("surface_seed", 1, "fractal: seed of the white noise (same surface on any number of ranks)"),
-    ("surface_generator", DEFAULT_GENERATOR, "fractal: filter (white noise filtered by sqrt(PSD): random amplitudes) | xu "
-                                    "((7.2)-(7.5): exact amplitude sqrt(PSD), random phase; the group presets')"),
+    ("surface_generator", DEFAULT_GENERATOR, "fractal: filter (white noise filtered by sqrt(PSD): random amplitudes) "
+                                             "| xu ((7.2)-(7.5): exact amplitude sqrt(PSD), random phase; the group "
+                                             "presets')"),
     ("surface_amplitude", 0.01, "bisinusoid: Delta of (3.52); wave: h of 2h sin^2(pi x/lambda) [length]"),
     ("surface_wavelength", 0.0, "bisinusoid/wave: wavelength along x (0 = the cell length)"),
     ("surface_radius", 10.0, "sphere: radius R of the paraboloid -r^2/(2R) [length]"),
@@ -52,19 +52,13 @@ def option_default(name):
 
 
 def option_values(opts, names):
-    """``{name: value}`` of the surface options ``names``, read with the type and default of :data:`SURFACE_OPTIONS`.
-
-    ``opts`` is a ``petsc4py.PETSc.Options`` (or anything with its ``get*`` methods).
-    """
+    """``{name: value}`` of the surface options ``names`` from ``opts``, with the types and defaults of the table."""
     read = {int: opts.getInt, float: opts.getReal, str: opts.getString}
     return {name: read[type(default)](name, default) for name in names for default in (option_default(name),)}
 
 
 def parameters(opts):
-    """The surface's parameters as used, defaults included: ``{option name: value}`` (for output files).
-
-    A surface read from a file is recorded by its path, -surface_L and -surface_detrend.
-    """
+    """The surface's parameters as used, defaults included, for output files: ``{option name: value}``."""
     if opts.getString("surface_file", ""):
         return option_values(opts, ("surface_file", "surface_L", "surface_detrend"))
     kind = opts.getString("surface_type", "fractal")
@@ -80,11 +74,8 @@ def grid_from_options(opts):
 def from_options(opts, seed=None, notes=None):
     """Build the surface named by the options: ``(grid, heights)``, heights of shape ``grid.shape``.
 
-    ``opts`` is a ``petsc4py.PETSc.Options`` (or anything with its ``get*``
-    methods). ``seed`` overrides ``-surface_seed`` (ensembles). The full array
-    is built on every rank, so the surface does not depend on the number of
-    ranks. A surface file is levelled by ``-surface_detrend`` (:func:`level`); its
-    :class:`Levelling` is appended to the list ``notes`` if one is given.
+    ``seed`` overrides ``-surface_seed``. The whole array is built on every rank, so the surface does not depend
+    on the number of ranks. A surface file's :class:`Levelling` (``-surface_detrend``) is appended to ``notes``.
     """
     path = opts.getString("surface_file", "")
     if path:

@@ -1,10 +1,7 @@
 """Where the standard output goes: a person at a terminal, a pipe or a file, also under ``mpiexec``.
 
-Under ``mpiexec`` a rank's ``isatty()`` says little: Open MPI gives every rank a pseudo-terminal and
-forwards what it prints to its own output, which may be a file or a pipe. Whether a person watches is
-then decided by the launcher's own standard output (:func:`watched`). A reader that stops early
-(``| head``) closes the pipe; :class:`ClosedPipeTolerant` lets the run go on without printing rather than
-end in PETSc's SIGPIPE handler or a ``BrokenPipeError``.
+Under ``mpiexec`` every rank gets a pseudo-terminal, so the launcher's own standard output decides whether a
+person watches (:func:`watched`). :class:`ClosedPipeTolerant` lets the run go on after ``| head`` closes the pipe.
 """
 
 import io
@@ -74,9 +71,8 @@ def is_terminal_path(path):
 def watched(stream=None):
     """True when a person is likely to read ``stream`` (default ``sys.stdout``) as it is printed.
 
-    Outside a launcher: the stream is a terminal. Under a launcher: the stream is a terminal and so is
-    the launcher's standard output (read from ``/proc``); where the launcher cannot be found or read,
-    False: progress must not end up in a redirected log.
+    The stream is a terminal, and under a launcher so is the launcher's standard output (from ``/proc``); False
+    where that cannot be read: progress must not end up in a redirected log.
     """
     stream = sys.stdout if stream is None else stream
     try:
@@ -96,11 +92,7 @@ def watched(stream=None):
 
 
 class ClosedPipeTolerant(io.TextIOBase):
-    """A text stream that drops what it is given once its reader has gone (``BrokenPipeError``).
-
-    ``python -m roughpetsc ... | head -3`` then shows three lines, and the run still finishes and
-    writes its files.
-    """
+    """A text stream that drops what it is given once its reader has gone (``BrokenPipeError``)."""
 
     def __init__(self, stream):
         super().__init__()

@@ -1,8 +1,7 @@
 """The contact layer: the problems (elastic, adhesive), their results and certificates, the laws and the loads.
 
-A problem owns its surface, its operator (from :func:`roughpetsc.elastic.make_operator`) and its units; it
-knows its energy, its gradient and how to certify a solution (:meth:`certify`), not how to solve. The
-solvers (:mod:`roughpetsc.solvers`) depend on this layer, never the reverse.
+A problem owns its surface, operator and units, and certifies a solution; it does not solve. The solvers
+(:mod:`roughpetsc.solvers`) depend on this layer, never the reverse.
 """
 
 from ..lazy import exports

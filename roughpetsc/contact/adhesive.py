@@ -7,28 +7,19 @@ field g >= 0 at the mean gap gbar (the rigid separation, (3.38)) is
 
 ``<.>`` the mean over the nodes and ``S`` the stiffness (the inverse symbol pi E* |k| of the Westergaard
 compliance (3.33), zero at k = 0): the surface displacement is u = g - gbar + h and S kills constants.
-The gap stays bound-constrained; the mean gap is the one equality (displacement control). Adhesive
-contact is unstable under load control (it jumps in and out of contact), so paths run under
-displacement control and the load is an output.
+The gap is bound-constrained, the mean gap the one equality: adhesive contact jumps in and out of contact
+under load control, so paths run under displacement control and the load is an output.
 
-First-order conditions, with r = S (g + h) + phi'(g) and a multiplier lambda = -pbar (pbar the mean
-pressure, compressive positive):
+First-order conditions, with r = S (g + h) + phi'(g) and a multiplier lambda = -pbar (compressive positive):
+out of contact (g > 0) r = lambda, the total pressure S(g + h) + pbar equals the law's traction -phi'(g);
+in contact (g = 0) the contact pressure c = r - lambda >= 0.
 
-* out of contact (g > 0): r = lambda, i.e. the total pressure p = S(g + h) + pbar equals the law's
-  traction -phi'(g);
-* in contact (g = 0): the contact pressure c = r - lambda >= 0.
+The certified natural residual is ``max |min(g / sqrt(m0^h), (r - lambda) / sqrt(m0^p))|`` on a fresh S g,
+lambda the mean of r out of contact, sqrt(m0^p) (2.52) that of the non-adhesive problem (the mean pressure
+may be zero or tensile here). ``load_error`` is the mean gap's error over sqrt(m0^h).
 
-The natural residual certified after every solve is ``max |min(g / sqrt(m0^h), (r - lambda) /
-sqrt(m0^p))|`` over all nodes, on a gap whose S g is computed afresh, with lambda the mean of r out of
-contact (the best multiplier for those nodes). Its pressure scale sqrt(m0^p) (2.52) is that of the
-non-adhesive problem (the mean pressure may be zero or tensile here). The report's ``load_error`` is
-the error of the prescribed quantity, the mean gap, over sqrt(m0^h); a converged solve has both below
-the tolerance.
-
-Only the periodic boundary is supported (the free boundary's stiffness is not a Fourier filter). The problem
-knows its energy, gradient and certificate; the solvers of :mod:`roughpetsc.solvers` (the projected CG on the
-gap, ``gapcg``, and TAO ALMM, ``almm``) solve it through the :class:`~roughpetsc.solvers.Solver` facade like
-any other problem.
+Periodic boundary only (the free boundary's stiffness is not a Fourier filter). Solved by ``gapcg`` and
+``almm`` through the :class:`~roughpetsc.solvers.Solver` facade.
 """
 
 import math
@@ -49,17 +40,11 @@ class AdhesiveProblem:
     Parameters
     ----------
     problem : ContactProblem
-        Periodic, without a hardness cap. Its surface, operator and units are used; it stays the caller's to
-        destroy.
+        Periodic, without a hardness cap; it stays the caller's to destroy.
     law : laws.Dugdale or laws.Exponential
         In the problem's units (pressure units of E*, length units of the heights).
 
-    Attributes
-    ----------
-    kind : str
-        ``"adhesive"``: the solvers registered for this kind solve it (:mod:`roughpetsc.solvers.registry`).
-    controls : tuple
-        Displacement control only: adhesive contact jumps in and out of contact under load control.
+    ``kind`` is ``"adhesive"`` (:mod:`roughpetsc.solvers.registry`); ``controls`` displacement control only.
     """
 
     kind = "adhesive"
@@ -80,8 +65,7 @@ class AdhesiveProblem:
 
     # --- what every problem offers the solvers (roughpetsc.solvers.protocol) ---------
     def __getattr__(self, name):
-        # The layout, units and surface of the elastic problem (comm, mpi, n, operator, vec, local, heights,
-        # height_scale, pressure_scale, ...) are this problem's too.
+        # The layout, units and surface of the elastic problem are this problem's too.
         if name == "elastic_problem":
             raise AttributeError(name)
         return getattr(self.elastic_problem, name)
@@ -97,7 +81,7 @@ class AdhesiveProblem:
         return gbar / self.height_scale
 
     def continuation(self, keeps_displacement=False):
-        """The gap and the rule of its starts along a path (:class:`~roughpetsc.contact.continuation.GapContinuation`)."""
+        """The gap and its starts along a path (:class:`~roughpetsc.contact.continuation.GapContinuation`)."""
         from .continuation import GapContinuation
 
         return GapContinuation(self)
@@ -118,8 +102,7 @@ class AdhesiveProblem:
         out += elastic
 
     def multiplier(self, g, r, open_nodes):
-        """lambda, the mean of r out of contact; ``open_nodes`` (bool, contiguous, written) marks g > 0. Also their
-        count."""
+        """``(lambda, count)``: the mean of r over the ``count`` nodes out of contact, marked in ``open_nodes``."""
         count, r_sum = allsum(self.mpi, loops.open_sums(g.ravel(), r.ravel(), open_nodes.reshape(-1)))
         return (r_sum / count if count else 0.0), count
 
@@ -128,10 +111,9 @@ class AdhesiveProblem:
         return float(allmax(self.mpi, [loops.gap_natural(g.ravel(), r.ravel(), lam, self.residual_scale)])[0])
 
     def stationarity(self, g, elastic):
-        """``(r, lambda, report)`` of local arrays ``g`` and ``elastic`` = S (g + h) (module docstring).
+        """``(r, lambda, report)`` of local arrays ``g`` and ``elastic`` = S (g + h).
 
-        The report: ``natural`` as above, ``min_p`` the least contact pressure r - lambda in contact and
-        ``complementarity`` the mean of g |r - lambda| out of contact (both over sqrt(m0^p)), ``min_g``.
+        ``min_p``: the least r - lambda in contact; ``complementarity``: mean g |r - lambda| out of contact.
         """
         r = np.empty_like(g)
         self.gradient(g, elastic, r)
@@ -168,10 +150,7 @@ class AdhesiveProblem:
 
     # --- results ----------------------------------------------------------------
     def certify(self, unknown, work, outcome, target, control, rtol, solver, started, applications):
-        """The :class:`Result` of the gap ``unknown`` at the scaled mean gap ``target``, certified on a fresh S g.
-
-        ``work`` receives S (g + h) (the pressure of :meth:`fields`).
-        """
+        """The :class:`Result` of the gap ``unknown`` at mean gap ``target``, certified on a fresh S g (in ``work``)."""
         self.elastic_pressure(unknown, work)
         g = self.local(unknown, readonly=True)
         elastic = self.local(work, readonly=True)
@@ -191,28 +170,18 @@ class AdhesiveProblem:
             control="displacement", history=outcome.history)
 
     def fields(self, unknown, work, result):
-        """This rank's rows of the total pressure (compressive positive) and the gap of ``result``.
-
-        Pressure and length units. The pressure is S (g + h) + pbar: the contact pressure in contact,
-        the law's traction -phi'(g) out of it.
-        """
+        """This rank's rows of the total pressure S (g + h) + pbar (compressive positive) and the gap, in units."""
         pressure = self.local(work, readonly=True) * self.pressure_scale + result.pbar
         return pressure, self.local(unknown, readonly=True) * self.height_scale
 
 
 def summit_radius(m4h):
-    """1 / (mean summit curvature (8/3) sqrt(m4^h / pi)) (Nayak's high-bandwidth limit), length units.
-
-    The radius with which the header's Tabor parameter describes a rough surface.
-    """
+    """1 / (mean summit curvature (8/3) sqrt(m4^h / pi)) (Nayak's high-bandwidth limit), length units."""
     return 1.0 / (8.0 / 3.0 * math.sqrt(m4h / math.pi))
 
 
 def approach_retraction(gbar_max, gbar_min, steps):
-    """Mean gaps from ``gbar_max`` down to ``gbar_min`` and back up, ``steps`` each way (length units).
-
-    The turning point appears once; a path along it shows the hysteresis of adhesive contact.
-    """
+    """Mean gaps from ``gbar_max`` down to ``gbar_min`` and back up, ``steps`` each way; the turn appears once."""
     down = np.linspace(gbar_max, gbar_min, steps + 1)
     return np.concatenate([down, down[-2::-1]])
 
@@ -220,9 +189,8 @@ def approach_retraction(gbar_max, gbar_min, steps):
 def dissipated_energy(gbars, pbars):
     """Energy dissipated per unit area in one approach-retraction cycle: -closed integral of pbar dgbar.
 
-    d Pi / d gbar = -pbar along every equilibrium branch, so the work -integral pbar dgbar put in
-    around a closed cycle is what the jumps in and out of contact dissipated. Trapezoids over the
-    path (pressure x length units); positive for a hysteresis loop.
+    d Pi / d gbar = -pbar on every equilibrium branch, so the work around a closed cycle is what the jumps
+    dissipated. Trapezoids over the path (pressure x length units); positive for a hysteresis loop.
     """
     gbars, pbars = np.asarray(gbars), np.asarray(pbars)
     return float(-np.sum(0.5 * (pbars[1:] + pbars[:-1]) * np.diff(gbars)))

@@ -1,11 +1,7 @@
 """KKT residuals of the contact problem (3.41)-(3.44) of the dissertation and the TAO convergence test.
 
-The residuals and their scaling follow docs/conventions.md ("Residuals").
-
-All residuals are scale-free: pressures are divided by the mean pressure pbar,
-gaps by the rms height sqrt(m0^h). In the scaled variables of
-:class:`roughpetsc.contact.ContactProblem` the rms height is 1, so gaps enter
-as they are.
+Scale-free residuals (docs/conventions.md, "Residuals"): pressures over the mean pressure pbar, gaps over the
+rms height sqrt(m0^h), which is 1 in the scaled variables of :class:`roughpetsc.contact.ContactProblem`.
 """
 
 from dataclasses import dataclass, asdict
@@ -45,9 +41,8 @@ class KKTReport:
 def report(comm, pressure, gap, n_total, target_pbar=None, upper=None):
     """KKT report of local arrays ``pressure``, ``gap`` (scaled units, rms height 1).
 
-    ``target_pbar`` is the prescribed mean pressure under load control (None
-    under displacement control, where the solution's own mean is used).
-    ``upper`` is the hardness cap in the same units (None: no upper bound).
+    ``target_pbar``: the prescribed mean pressure (None under displacement control: the solution's own mean).
+    ``upper``: the hardness cap in the same units (None: no upper bound).
     """
     pressure, gap = pressure.ravel(), gap.ravel()
     residual, high = np.empty_like(pressure), np.empty_like(pressure)
@@ -94,10 +89,8 @@ def certified(reason, kkt, rtol, load_name="load error", gradient="gap"):
     """``(converged, reason)`` of a result whose certificate, on a fresh ``gradient``, is ``kkt``.
 
     Converged: the natural residual and the load error are at most ``rtol``; the solver's ``reason`` stands.
-    Otherwise a solver's own best residual (ALMM's merit, on its cached gradient, of an iterate it may not
-    return) can differ from the certificate of the result, which the output files record: the reason quotes
-    the latter, so that the line and the files give the same numbers, and a reason whose solver's own test
-    passed becomes ``NOT_CERTIFIED``.
+    Otherwise the reason quotes the certificate (which the files record) in place of the solver's own best
+    residual, and a reason whose solver's own test passed becomes ``NOT_CERTIFIED``.
     """
     if kkt.natural <= rtol and (kkt.load_error is None or kkt.load_error <= rtol):
         return True, reason
@@ -115,15 +108,12 @@ class CompositeCriterion:
 
     (3.47) ||p^k - p^(k-1)||_2 / ||p^k||_2 < 5e-5;
     (3.48) |A^k - A^(k-1)| / A^k < 2 / (Nx Ny);
-    (3.51) sigma_h < min(1e-4 sqrt(m0^h), 0.01 gbar), sigma_h the rms gap over the contact
-           nodes as in (3.50) (the mean over them; the dissertation's 1/N is read as 1/|contact set|).
-    (3.49), monotone A* and gbar along a load path, involves two solves and is
-    checked by the callers that have a path (ensembles).
+    (3.51) sigma_h < min(1e-4 sqrt(m0^h), 0.01 gbar), sigma_h the rms gap (3.50) over the contact nodes
+           (the dissertation's 1/N read as 1/|contact set|).
+    (3.49), monotone A* and gbar along a path, is checked by the callers that have a path (ensembles).
 
-    ``gap_of(x)`` returns the gap (scaled, local array) of the iterate ``x``.
-    ``rows`` holds (iteration, (3.47) value, (3.48) value, sigma_h, its bound,
-    natural residual or nan); ``first`` is the first iteration where (3.47),
-    (3.48) and (3.51) all hold.
+    ``gap_of(x)``: the gap (scaled, local) of iterate ``x``. ``rows``: (iteration, (3.47), (3.48), sigma_h, its
+    bound, natural residual or nan); ``first``: the first iteration where (3.47), (3.48) and (3.51) all hold.
     """
 
     def __init__(self, comm, n_total, gap_of, natural_of=None):

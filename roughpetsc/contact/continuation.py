@@ -1,11 +1,7 @@
 """The warm starts of a path: the unknown of a problem and the start of each solve from the previous solutions.
 
-:class:`PressureContinuation` (the elastic contact problem, pressure as the unknown) and
-:class:`GapContinuation` (the adhesive problem, gap as the unknown) follow the continuation protocol of
-:mod:`roughpetsc.solvers.protocol`: ``unknown``, ``start(control, target, start) -> Guess``,
-``record(control, target, outcome, work)``, ``destroy()``. The start of each load-controlled solve of the
-pressure is predicted from the previous solutions along the load path (e.g. the history (7.11) of the
-dissertation; :meth:`PressureContinuation.load_start`).
+:class:`PressureContinuation` (pressure as the unknown) and :class:`GapContinuation` (adhesive, gap as the
+unknown) follow the continuation protocol of :mod:`roughpetsc.solvers.protocol`.
 """
 
 import numpy as np
@@ -25,9 +21,7 @@ class PressureContinuation:
 
     Attributes
     ----------
-    unknown : petsc4py.PETSc.Vec
-        The pressure (the problem's unknown), below.
-    pressure : petsc4py.PETSc.Vec
+    unknown, pressure : petsc4py.PETSc.Vec
         The current pressure (scaled): the start before a solve, the solution after it.
     previous : petsc4py.PETSc.Vec or None
         The solution before the last (load paths only).
@@ -53,9 +47,8 @@ class PressureContinuation:
     def start(self, control, target, start=None):
         """Put the start of a solve at ``target`` in :attr:`unknown`; the :class:`Guess` of the backend.
 
-        Under load control the start is the load-path predictor (:meth:`load_start`) and the backend may stop
-        unconfirmed (the facade certifies every result afresh); under displacement control the previous
-        solution is the start. ``start`` names another start ('uniform': the uniform load).
+        Load control: the load-path predictor (:meth:`load_start`), unconfirmed (every result is certified
+        afresh); displacement control: the previous solution. ``start='uniform'``: the uniform load.
         """
         from ..solvers.protocol import Guess
 
@@ -72,16 +65,10 @@ class PressureContinuation:
     def load_start(self, target):
         """Put the start of a load-controlled solve at ``target`` in :attr:`pressure`; its K p if known.
 
-        After two load-controlled solves, the pressure is extrapolated
-        linearly in the load from them (step ratio capped at 2), projected onto p >= 0; it
-        is then scaled to the new mean pressure. After one, that solution is
-        scaled; with none, the start is uniform.
-
-        Returns K p of the start when it follows from the kept K p of the previous solutions (the
-        same combination, exact when the projection changed nothing; K of a uniform pressure is 0;
-        one FFT pair saved per step), else None. Other choices tried along the 95-step history (quadratic or cubic extrapolation in the
-        load, linear or quadratic in log or sqrt of the load, the predicted gap's entering nodes) started
-        no closer: see studies/load_history.py.
+        After two load-controlled solves, linear extrapolation in the load (step ratio capped at 2), projected
+        onto p >= 0; after one, that solution; with none, uniform; then scaled to the new mean pressure.
+        Returns K p of the start when the kept K p of the previous solutions give it exactly (one FFT pair
+        saved per step), else None. Higher-order predictors started no closer (studies/load_history.py).
         """
         displacements = self.displacements
         known = self.keeps_displacement and len(displacements) == len(self.targets)
@@ -126,11 +113,8 @@ class PressureContinuation:
         return self.start_displacement if known else None
 
     def record(self, control, target, outcome, gap):
-        """Remember the certified solution in :attr:`pressure` at ``target``, and its separation.
-
-        ``gap`` is its fresh gap (the certificate's): K p = g - d + h is kept when ``keeps_displacement``
-        (load control).
-        """
+        """Remember the certified solution at ``target`` and its separation; with ``keeps_displacement`` (load
+        control) also K p = g - d + h of its fresh ``gap``."""
         self.last_separation = separation = outcome.separation
         target = target if control == "load" else None
         self.targets = (self.targets + [target])[-2:] if target is not None else []
@@ -157,12 +141,10 @@ class PressureContinuation:
 class GapContinuation:
     """The gap of an adhesive problem and its starts along a path of mean gaps.
 
-    The first solve starts from the rigid gap max(gbar - h, 0) shifted to mean gbar; later ones from the
-    previous gap shifted by the change of gbar (both projected onto g >= 0, mean gbar by the solver). Along a
-    retraction, keep each step below the range of the law: a longer one starts the solver with the whole
-    contact opened beyond the law's reach, and the path snaps off early. ``start="rigid"`` or ``"uniform"``
-    (g = gbar everywhere, the start of Tamaas' solver) forces a start: the local minimum a non-convex problem
-    reaches depends on it.
+    The first solve starts from the rigid gap gbar - h, later ones from the previous gap shifted by the change
+    of gbar (the solver projects onto g >= 0, mean gbar). Along a retraction keep each step below the law's
+    range, or the path snaps off early. ``start="rigid"`` or ``"uniform"`` (g = gbar, Tamaas' start) forces a
+    start: the local minimum of the non-convex problem depends on it.
     """
 
     STARTS = (None, "rigid", "uniform")

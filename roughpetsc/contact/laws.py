@@ -1,19 +1,11 @@
 """Adhesive interaction laws: an energy per unit area phi(g) of the local gap g >= 0.
 
-The adhesive contact problem adds ``sum phi(g) dA`` to the elastic energy (chapter 6 of the
-dissertation treats the same laws in its closed-form models): ``phi(0) = -w`` with ``w`` the work of
-adhesion (energy per unit area, pressure x length units) and ``phi -> 0`` beyond the range of the
-law. ``force(g) = phi'(g) >= 0`` is the magnitude of the attractive (tensile) stress the law exerts at
-gap g; ``curvature(g) = phi''(g)``.
+``phi(0) = -w``, w the work of adhesion (pressure x length units), ``phi -> 0`` beyond the law's range (the
+laws of chapter 6). ``force(g) = phi'(g) >= 0`` is the tensile stress at gap g, ``curvature(g) = phi''(g)``.
 
-Laws
-----
-``Dugdale(work, stress)``
-    The Maugis-Dugdale law: a constant tensile stress sigma0 up to the range h0 = w / sigma0,
-    ``phi = -w + sigma0 g`` for g < h0, 0 beyond (Maugis, J. Colloid Interface Sci. 150, 1992).
-``Exponential(work, range_)``
-    ``phi = -w exp(-g / rho)``: peak stress w / rho at contact (Rey, Anciaux and Molinari, Comput. Mech.
-    60, 2017 use it for rough surfaces).
+``Dugdale(work, stress)``: sigma0 up to h0 = w / sigma0, ``phi = -w + sigma0 g`` for g < h0 (Maugis,
+J. Colloid Interface Sci. 150, 1992). ``Exponential(work, range_)``: ``phi = -w exp(-g / rho)``, peak stress
+w / rho (Rey, Anciaux and Molinari, Comput. Mech. 60, 2017).
 """
 
 import math
@@ -26,8 +18,7 @@ LAWS = ("none", "dugdale", "exponential")
 
 
 def _positive(name, value, what):
-    """``value`` as a float; :class:`ParameterError` naming ``name`` if it is missing (None), or not positive and
-    finite (quoting it)."""
+    """``value`` as a float; :class:`ParameterError` naming ``name`` unless given, positive and finite."""
     if value is None:
         raise ParameterError(name, f"the {what} is missing: give a positive value")
     if not (value > 0 and math.isfinite(value)):
@@ -62,9 +53,8 @@ class Dugdale:
         return self.energy_changes_from(gap)(trial, np.empty_like(trial))
 
     def energy_changes_from(self, gap, scratch=None):
-        """``change(trial, out)``: :meth:`energy_change` from ``gap`` written to ``out`` (which may be ``trial``),
-        the part of ``gap`` made once (a line search calls it for every trial step); ``scratch``: two arrays
-        of gap's shape it may keep (allocated if None)."""
+        """``change(trial, out)``: :meth:`energy_change` from ``gap`` into ``out`` (may be ``trial``), the part of
+        ``gap`` made once; ``scratch``: two arrays of gap's shape it may keep (allocated if None)."""
         base = np.minimum(gap, self.range, out=None if scratch is None else scratch[0])
 
         def change(trial, out):
@@ -109,20 +99,17 @@ class Exponential:
         return -self.work * np.exp(-gap / self.range)
 
     def energy_change(self, gap, trial):
-        """``phi(trial) - phi(gap)`` node by node, in a form that does not cancel for close gaps.
+        """``phi(trial) - phi(gap)`` node by node, without cancellation for close gaps.
 
-        Below g = 0 (a line search's trial before its projection) phi is continued by its tangent at 0,
-        as the Dugdale law continues itself, so that a long step cannot gain unbounded energy.
+        Below g = 0 phi continues along its tangent at 0 (as Dugdale's does): a long step gains bounded energy.
         """
         return self.energy_changes_from(gap)(trial, np.empty_like(trial))
 
     def energy_changes_from(self, gap, scratch=None):
-        """``change(trial, out)``: :meth:`energy_change` from ``gap`` written to ``out`` (which may be ``trial``);
-        ``scratch``: three arrays of gap's shape it keeps (allocated if None).
+        """``change(trial, out)`` as Dugdale's; ``scratch``: three arrays of gap's shape (allocated if None).
 
-        phi(t) - phi(g) = s phi(min(g, t)) expm1(-|g - t| / rho), s = 1 for t >= g and -1 below: one
-        expm1 that does not cancel for close gaps, and exponents that are never positive, so that no
-        range however short overflows (exp(-g / rho) may underflow to 0, which is phi's value then).
+        phi(t) - phi(g) = s phi(min(g, t)) expm1(-|g - t| / rho), s = sign(t - g): no cancellation for close
+        gaps, and no positive exponent, so no range however short overflows.
         """
         difference, smaller, factor = scratch if scratch is not None else (
             np.empty_like(gap), np.empty_like(gap), np.empty_like(gap))
@@ -186,11 +173,6 @@ def make_law(kind, work=None, stress=None, range_=None):
 
 
 def tabor_parameter(law, radius, E_star):
-    """Tabor's parameter mu = (R w^2 / (E*^2 z0^3))^(1/3) with z0 the law's range (dimensionless).
-
-    Large mu: the JKR limit (short-range adhesion, compliant bodies); small mu: the DMT limit. For
-    the Dugdale law Maugis's lambda (:func:`roughpetsc.models.sphere_adhesion.maugis_parameter`) is
-    the usual form.
-    """
+    """Tabor's parameter mu = (R w^2 / (E*^2 z0^3))^(1/3), z0 the law's range: large mu JKR, small mu DMT."""
     return (radius * law.work ** 2 / (E_star ** 2 * law.range ** 3)) ** (1.0 / 3.0)
 

@@ -1,14 +1,12 @@
 """Load paths in p* = pbar / sqrt(m0^p): the load history (7.11) of the dissertation and user lists.
 
-Eq. (7.11) of the dissertation divides p* in (0, 4] into three stages with n1 = 30,
-n2 = 45 and n3 = 20 sub-steps::
+Eq. (7.11) divides p* in (0, 4] into three stages of 30, 45 and 20 sub-steps::
 
     p*_i = i D1                              0 < i <= 30
     p*_i = exp(ln 0.2 + D2 (i - 30))        30 < i <= 75
     p*_i = 2 + D3 (i - 75)                  75 < i <= 95
 
-with D1 = 0.2 / 30 (erratum of (7.11) in docs/conventions.md, which also notes where the second stage ends),
-D2 = 0.0512 and D3 = 0.1; the history is strictly increasing and ends at p*_95 = 4.
+with D1 = 0.2 / 30 (erratum of (7.11), docs/conventions.md), D2 = 0.0512 and D3 = 0.1, ending at p*_95 = 4.
 """
 
 import math
@@ -39,9 +37,8 @@ LIST_FILE_PREFIX = "@"
 def parse_reals(text, name):
     """The reals of a list option: comma-separated in the value, or, for ``@FILE``, in that file.
 
-    A file holds numbers separated by commas, blanks or line ends; ``#`` starts a comment. Every item
-    is used exactly as given: an empty item (``0.5,,1``), a word or an empty list is refused, naming
-    ``-name`` (and the file). Returns a list of floats.
+    A file holds numbers separated by commas, blanks or line ends, ``#`` starting a comment. An empty item
+    (``0.5,,1``), a word or an empty list is refused, naming ``-name`` (and the file).
     """
     text = (text or "").strip()
     if text.startswith(LIST_FILE_PREFIX):
@@ -74,10 +71,7 @@ def parse_reals(text, name):
 
 
 def parse(text, option):
-    """Loads from an option value: ``history`` (7.11), or a list of positive p* (:func:`parse_reals`).
-
-    Raises :class:`UserError` naming ``-option`` on anything else.
-    """
+    """Loads from an option value: ``history`` (7.11), or a list of positive p*; else :class:`UserError`."""
     text = (text or "").strip()
     if text.lower() == "history":
         return history()

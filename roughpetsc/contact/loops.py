@@ -1,12 +1,8 @@
-"""The elementwise work of the solvers, fused: one iteration of Polonsky-Keer on the pressure
-(:mod:`~roughpetsc.solvers.polonsky_keer`) and of the adhesive gap CG (:mod:`~roughpetsc.solvers.gap_cg`), the
-residual of the adhesive certificate, and the callbacks of TAO's bound types (:mod:`~roughpetsc.solvers.bound_qp`:
-objective and gradient, convergence test, initial Hessian).
+"""The elementwise work of the solvers fused into compiled loops (numba, why: docs/solvers.md) over local flat arrays.
 
-Each function is one compiled loop (numba) over the local flat arrays (why: docs/solvers.md). The hardness
-cap enters as ``upper`` (``inf`` without one): a node is capped when ``p >= upper``, and the arithmetic with
-``inf`` reduces every test to the uncapped one. Masks are 0.0/1.0 float arrays (``contact``, ``free``) or
-boolean arrays (``open_nodes``).
+Polonsky-Keer, the adhesive gap CG and its certificate, and the callbacks of TAO's bound types. The hardness
+cap is ``upper`` (``inf`` without one). Masks are 0.0/1.0 floats (``contact``, ``free``) or booleans
+(``open_nodes``).
 """
 
 from numba import njit
@@ -14,10 +10,7 @@ from numba import njit
 
 @njit(cache=True, fastmath={"reassoc"})
 def contact_and_gap(p, displacement, heights, gap, contact, upper):
-    """``gap = K p - h``; ``contact`` 1.0 on the elastic contact set ``0 < p < upper``, 0.0 elsewhere.
-
-    Returns the local ``(|C|, sum of gap over C, sum of p)``.
-    """
+    """``gap = K p - h``, ``contact`` the set ``0 < p < upper``; local ``(|C|, sum of gap over C, sum of p)``."""
     count = gap_sum = total = 0.0
     for i in range(p.size):
         g = displacement[i] - heights[i]
@@ -32,11 +25,7 @@ def contact_and_gap(p, displacement, heights, gap, contact, upper):
 
 @njit(cache=True, fastmath={"reassoc"})
 def natural_residual(p, gap, separation, scale, upper):
-    """``gap += separation`` in place; the natural residual of the box 0 <= p <= upper, in units of ``scale``.
-
-    ``max |mid(p / scale, g, (p - upper) / scale)|`` (docs/conventions.md) and the local ``sum(p g)`` over
-    the nodes below the cap, as :func:`roughpetsc.kkt.report` gives them.
-    """
+    """``gap += separation``; local ``max |mid(p / scale, g, (p - upper) / scale)|`` and ``sum(p g)`` below the cap."""
     natural = complementarity = 0.0
     inverse = 1.0 / scale
     high = upper * inverse
@@ -53,10 +42,9 @@ def natural_residual(p, gap, separation, scale, upper):
 
 @njit(cache=True, fastmath={"reassoc"})
 def free_set(p, gap, contact, upper, overlapping):
-    """The free set of the step into ``contact``; returns the local ``(|F|, sum of gap over F)``.
+    """The free set F into ``contact``; local ``(|F|, sum of gap over F)``.
 
-    F is the elastic contact set, the capped nodes whose gap opens (they leave the cap), and with
-    ``overlapping`` (BCCG) the nodes below the cap whose gap is negative.
+    F: the elastic contact set, capped nodes whose gap opens, and with ``overlapping`` (BCCG) negative gaps.
     """
     count = gap_sum = 0.0
     for i in range(p.size):
@@ -109,10 +97,7 @@ def step_sums(response, contact, t, gap):
 
 @njit(cache=True, fastmath={"reassoc"})
 def take_step(p, t, displacement, response, step, upper):
-    """``p -= step t`` projected onto [0, upper], ``K p -= step K t`` (unprojected).
-
-    Returns the local ``(number of nodes the projection moved, sum of p)``.
-    """
+    """``p -= step t`` onto [0, upper], ``K p -= step K t``; local ``(nodes the projection moved, sum of p)``."""
     clipped = 0
     total = 0.0
     for i in range(p.size):
@@ -151,10 +136,7 @@ def capped_load(p, upper):
 
 @njit(cache=True, fastmath={"reassoc"})
 def scale_below_cap(p, upper, factor):
-    """``p *= factor`` below the cap, the capped nodes kept at it; a node lifted above the cap is capped.
-
-    Returns the local number of nodes so capped.
-    """
+    """``p *= factor`` below the cap, capping a node lifted above it; the local number so capped."""
     lifted = 0
     for i in range(p.size):
         if p[i] < upper:
@@ -164,7 +146,6 @@ def scale_below_cap(p, upper, factor):
                 lifted += 1
             p[i] = value
     return lifted
-
 
 
 # --- the adhesive gap CG ---------------------------------------------------------------------------------
@@ -287,13 +268,9 @@ def local_sum(x):
 def gradient_step(x, point, cached_gap, displacement, heights, separation, out, cached):
     """The gradient ``out = K x - h + separation`` and the step's dot products with it, in one pass.
 
-    ``displacement`` is K x (it may be ``out``). With ``cached`` (the previous point r and its gradient
-    g(r) are in ``point`` and ``cached_gap``) returns the local ``(s'g(r), s'g(x))`` of the step
-    s = x - r: their mean is the exact change of a quadratic objective from r to x
-    (:class:`roughpetsc.solvers.bound_qp.AugmentedQuadratic`), and -s'g(r) / (s'g(x) - s'g(r)) the
-    exact minimiser along s in units of s. Afterwards ``point = x`` and ``cached_gap = out``.
-
-    Returns ``(s'g(r), s'g(x), local sum of x)``; the dots are 0 without ``cached``.
+    ``displacement`` is K x (may be ``out``). With ``cached`` (the previous point r and g(r) in ``point`` and
+    ``cached_gap``) the dots of s = x - r: their mean is the exact change of a quadratic objective from r to x.
+    Afterwards ``point = x``, ``cached_gap = out``. Returns ``(s'g(r), s'g(x), local sum of x)`` (dots 0 uncached).
     """
     before = after = 0.0
     total = 0.0
@@ -313,11 +290,7 @@ def gradient_step(x, point, cached_gap, displacement, heights, separation, out, 
 
 @njit(cache=True, fastmath={"reassoc"})
 def natural_and_copy(p, gap, scale, upper, copy):
-    """The local natural residual ``max |mid(p / scale, g, (p - upper) / scale)|``; ``copy = p`` in the same pass.
-
-    The residual of :func:`roughpetsc.kkt.report` (docs/conventions.md), without the report's other
-    measures, which the convergence test does not use.
-    """
+    """The local natural residual ``max |mid(p / scale, g, (p - upper) / scale)|``; ``copy = p`` in the same pass."""
     natural = 0.0
     inverse = 1.0 / scale
     high = upper * inverse
@@ -331,11 +304,9 @@ def natural_and_copy(p, gap, scale, upper, copy):
 
 @njit(cache=True, fastmath={"reassoc"})
 def free_residual(p, gap, upper, source, mask, residual):
-    """The free set of a quasi-Newton step into ``mask`` (1.0/0.0) and ``residual = source`` on it, 0 elsewhere.
+    """The free set of a quasi-Newton step into ``mask`` and ``residual = source`` on it; local ``(|F|, sum)``.
 
-    Free: ``0 < p < upper``, or a node at a bound whose gradient points into the box (``p = 0``,
-    ``g < 0``; ``p = upper``, ``g > 0``), as in the BCCG active set of Polonsky-Keer.
-    Returns the local ``(|F|, sum of the residual)``.
+    Free: ``0 < p < upper``, or at a bound with the gradient pointing into the box (as BCCG's active set).
     """
     count = total = 0.0
     for i in range(p.size):

@@ -1,12 +1,8 @@
 """The contact problem (3.41)-(3.44) and its results.
 
-Internally the problem is dimensionless so that every solver sees numbers of
-order one whatever the unit system: heights are divided by the rms height
-``s = sqrt(m0^h)``, in-plane lengths by the cell length ``L`` along x, and
-pressures by ``E* s / L``. The compliance then has the symbol
-``1 / (pi |k|)`` (k in cycles per cell length) and the gap of a pressure field
-``p`` at rigid separation ``d`` is ``g = K p + d - h``: the gradient of the QP
-``min 1/2 p'Kp + p'(d - h), p >= 0``.
+Scaled internally so every solver sees numbers of order one: heights by the rms height ``s = sqrt(m0^h)``,
+in-plane lengths by the cell length ``L`` along x, pressures by ``E* s / L``. The compliance then has the
+symbol ``1 / (pi |k|)`` and the gap ``g = K p + d - h`` is the gradient of ``min 1/2 p'Kp + p'(d - h), p >= 0``.
 """
 
 import math
@@ -31,40 +27,34 @@ class ContactProblem:
     grid : surfaces.Grid
         The periodic cell (length units).
     heights : ndarray (n0, n1)
-        The whole surface, length units (every rank passes the same array). Its mean is removed: the mean height
-        only shifts the rigid separation, and every scale (sqrt(m0^h), the bracket of the separation,
-        p*) is that of the zero-mean surface.
+        The whole surface, length units, the same on every rank. Its mean is removed (it only shifts the
+        rigid separation).
     E_star : float
         Composite modulus E* (1.6), pressure units.
     comm : petsc4py.PETSc.Comm
     fft_threads, fft_effort :
         Passed to the operator.
     boundary : "periodic" or "free"
-        ``periodic``: the cell repeats (the Westergaard compliance (3.33)); ``free``: an isolated
-        body, nothing outside the grid (Love's coefficients (3.31) by a padded FFT,
-        :class:`~roughpetsc.love.FreeBoundary`). Under ``free`` the mean gap is not the rigid
-        separation, no load gives complete contact exactly, and p* still uses sqrt(m0^p) of the
-        pressure surface (2.47) of the heights, a statistic of the surface.
+        ``periodic``: the Westergaard compliance (3.33); ``free``: an isolated body, Love's coefficients
+        (3.31) by a padded FFT. Under ``free`` the mean gap is not the rigid separation, no load gives
+        complete contact exactly, and p* still uses sqrt(m0^p) of the pressure surface (2.47).
     hardness : float or None
         The hardness cap H, pressure units: perfect plasticity as ``0 <= p <= H`` (None: none).
     operator_factory : callable
-        ``operator_factory(boundary, grid, E_star, comm, fft_threads, fft_effort)`` returns the compliance
-        (:func:`roughpetsc.elastic.make_operator` by default); it is called with the problem's scaled grid
-        (cell length 1 along x) and E* = 1.
+        ``operator_factory(boundary, grid, E_star, comm, fft_threads, fft_effort)`` returns the compliance;
+        called with the scaled grid (cell length 1 along x) and E* = 1.
 
     Attributes
     ----------
     kind : str
-        ``"contact"``: the solvers registered for this kind solve it (:mod:`roughpetsc.solvers.registry`).
+        ``"contact"``, the key of :mod:`roughpetsc.solvers.registry`.
     controls : tuple
         Load control (a mean pressure) and displacement control (a mean gap).
     progress : callable or None
-        Called as ``progress(iteration, natural_residual, seconds)`` with every residual that a
-        solver of this problem records (:class:`~roughpetsc.kkt.History`); None by default.
+        ``progress(iteration, natural_residual, seconds)``, called with every residual a solver records.
     stop_requested : callable or None
-        ``stop_requested()`` is True when this process was asked to stop (Ctrl-C,
-        :class:`roughpetsc.interrupts.StopRequests`); every solve then ends at its next iteration, on
-        every rank alike (:meth:`~roughpetsc.kkt.History.out_of_time`). Set it on every rank or none.
+        ``stop_requested()`` is True once a stop was asked for (Ctrl-C); every solve then ends at its next
+        iteration on every rank alike. Set it on every rank or none.
     """
 
     kind = "contact"
@@ -134,10 +124,9 @@ class ContactProblem:
         out.shift(separation)
 
     def contact_separation(self, pressure, elastic_gap):
-        """The rigid separation d for which the gap has zero mean on the contact set (PK's choice).
+        """The rigid separation d giving the gap zero mean on the contact set (PK's choice).
 
-        ``elastic_gap`` is ``K p - h``, the gap at d = 0 (local array of this rank). Under a hardness
-        cap the contact set is the elastic one (0 < p < H): the gap of a plastic node may be negative.
+        ``elastic_gap``: local ``K p - h``. Under a hardness cap the contact set is the elastic one (0 < p < H).
         """
         local = self.local(pressure, readonly=True)
         in_contact = local > 0
@@ -192,11 +181,9 @@ class ContactProblem:
         return PressureContinuation(self, keeps_displacement)
 
     def exact(self, target, control, unknown):
-        """Beyond complete contact the exact answer is p = pbar + p_c, g = 0 (d = 0): put in ``unknown``.
+        """Beyond complete contact the exact answer p = pbar + p_c, g = 0 (d = 0) into ``unknown``; its Outcome.
 
-        Returns the :class:`~roughpetsc.solvers.protocol.Outcome` of that answer, or None below complete
-        contact (and under displacement control). Under a hardness cap only while that answer stays below the
-        cap everywhere.
+        None below complete contact, under displacement control, or where that answer exceeds the cap.
         """
         from ..solvers.protocol import Outcome
 
@@ -210,9 +197,8 @@ class ContactProblem:
     def certify(self, unknown, work, outcome, target, control, rtol, solver, started, applications):
         """The :class:`~roughpetsc.contact.Result` of the pressure ``unknown``, certified on a fresh gap.
 
-        ``work`` receives the gap, computed afresh from the pressure (one operator application), whatever
-        the solver cached: the natural KKT residual (docs/conventions.md) and, under load control, the load
-        error are checked on it against ``rtol``.
+        ``work`` receives the gap computed afresh (one operator application); the natural KKT residual and,
+        under load control, the load error are checked on it against ``rtol``.
         """
         load_target = target if control == "load" else None
         self.gap(unknown, outcome.separation, work)

@@ -9,9 +9,8 @@ from ..parallel import allsum, next_rank_first_row
 from .certificate import KKTReport
 
 
-# Perimeter correction of the node-count contact area, Yastrebov, Anciaux and
-# Molinari, Tribol. Int. 114 (2017): A = A_nodes - c P_d dx with the staircase
-# perimeter P_d of the contact set on the square grid.
+# Perimeter correction of the node-count contact area, Yastrebov, Anciaux and Molinari, Tribol. Int. 114
+# (2017): A = A_nodes - c P_d dx with the staircase perimeter P_d of the contact set on the square grid.
 PERIMETER_COEFFICIENT = (math.pi - 1.0 + math.log(2.0)) / 24.0
 
 
@@ -19,10 +18,9 @@ PERIMETER_COEFFICIENT = (math.pi - 1.0 + math.log(2.0)) / 24.0
 class Result:
     """What one solve at one load gives; the same type for every solver.
 
-    Pressures in pressure units, gaps in length units; ``pstar`` = pbar /
-    sqrt(m0^p), ``gstar`` = gbar / sqrt(m0^h); ``A`` by node count (3.45),
-    ``A_corrected`` with the perimeter correction; ``rms_gap_contact`` is (3.50) (over the elastic
-    contact nodes under a hardness cap); ``A_plastic`` the fraction of nodes at the cap (0 without one).
+    Pressures in pressure units, gaps in length units; ``pstar`` = pbar / sqrt(m0^p), ``gstar`` = gbar /
+    sqrt(m0^h); ``A`` by node count (3.45), ``A_corrected`` with the perimeter correction; ``rms_gap_contact``
+    (3.50) over the elastic contact nodes; ``A_plastic`` the fraction of nodes at the cap.
     """
 
     pbar: float
@@ -52,10 +50,7 @@ class Result:
 
 
 def contact_perimeter_edges(problem, in_contact):
-    """Number of grid edges between a contact and a non-contact node (periodic), summed over ranks.
-
-    Returns ``(edges along axis 1, edges along axis 0)``.
-    """
+    """``(along axis 1, along axis 0)``: the grid edges between contact and non-contact nodes, all ranks."""
     along_x = np.count_nonzero(in_contact != np.roll(in_contact, -1, axis=1))
     below = next_rank_first_row(problem.mpi, in_contact)
     along_y = np.count_nonzero(in_contact[:-1] != in_contact[1:]) + np.count_nonzero(in_contact[-1] != below)
@@ -65,10 +60,8 @@ def contact_perimeter_edges(problem, in_contact):
 def measure(problem, pressure, gap):
     """Contact measures of a solution (scaled local arrays ``pressure``, ``gap``).
 
-    Returns a dict with A (3.45), A_corrected, gbar (3.46 with the erratum of
-    docs/conventions.md: the mean over all nodes of the gap, zero in contact), the rms gap in
-    contact (3.50) and the plastic fraction A_plastic (nodes at the hardness cap), all in scaled
-    units except the area fractions.
+    A (3.45), A_corrected, gbar ((3.46) with the erratum of docs/conventions.md), the rms gap in contact (3.50),
+    pbar and the plastic fraction A_plastic, in scaled units.
     """
     in_contact = pressure > 0
     plastic = np.zeros_like(in_contact) if problem.upper_bound is None else pressure >= problem.upper_bound
@@ -80,7 +73,6 @@ def measure(problem, pressure, gap):
     edges_x, edges_y = contact_perimeter_edges(problem, in_contact)
     grid = problem.grid
     dx, dy = grid.l1 / grid.n1, grid.l0 / grid.n0
-    # Edge between x-neighbours has length dy; the correction strip is c * P_d * dx.
     perimeter = edges_x * dy + edges_y * dx
     area = n_contact / problem.n
     corrected = area - PERIMETER_COEFFICIENT * perimeter * math.sqrt(dx * dy) / grid.area

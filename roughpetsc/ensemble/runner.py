@@ -23,11 +23,8 @@ from .statistics import compute_models, step_statistics
 
 
 def probe_solver(s):
-    """Build the solver once on a tiny problem (rank-local): checks -tao_type and reads the TAO options.
-
-    Returns the solver's name. After this, ``check_unused`` sees every option
-    a real solve would read, so misspellings fail before any work.
-    """
+    """Build the solver once on a tiny rank-local problem, so that -tao_type and every TAO option are read before
+    any work (``check_unused``); the solver's name."""
     from petsc4py import PETSc
 
     from ..contact.problem import ContactProblem
@@ -49,12 +46,9 @@ def probe_solver(s):
 def share_fftw_wisdom(comm, group, s, stored):
     """Make every rank, in this run and in any resumed run, use the same FFTW plans.
 
-    FFTW_MEASURE picks plans by timing, so two processes may transform with
-    different algorithms and round differently (1e-13 relative differences in
-    g*). Here group 0 plans the transforms of the grid once (from the wisdom
-    stored in the file, if any), world rank 0 exports its wisdom, and every
-    other rank forgets its own and imports that one before any surface is
-    built. Returns the wisdom (base64 JSON) to store in the file.
+    FFTW_MEASURE picks plans by timing, and different plans round differently (1e-13 in g*). Group 0 plans the
+    grid once (from the file's wisdom, if any) and every other rank imports world rank 0's wisdom. Returns the
+    wisdom (base64 JSON) to store in the file.
     """
     import pyfftw
     from petsc4py import PETSc
@@ -80,11 +74,8 @@ def share_fftw_wisdom(comm, group, s, stored):
 
 
 def solve_surface(reader, s, index, seed, group, run_id, between_steps):
-    """Solve one surface along the loads on the group communicator; the record (leader) or None (other ranks).
-
-    The record is ``{"surface": {field: value}, "steps": {field: (m,)}, "reason": [str] * m}`` with the
-    fields of :data:`roughpetsc.store.ensemble_file.SURFACE_FIELDS` and ``STEP_COLUMNS``.
-    """
+    """Solve one surface along the loads on the group; the record of :mod:`roughpetsc.store.ensemble_file` on the
+    leader, None on the other ranks."""
     from petsc4py import PETSc
 
     from ..app import surface_options
@@ -253,11 +244,9 @@ class Ensemble:
             if self.rank == 0:
                 self.accept(record, 0)
             elif self.leader:
-                # Stay until rank 0 has taken the record (it looks between its load steps, so this lasts at
-                # most one of its steps). Rank 0 receives with a blocking recv as soon as it sees the message,
-                # and a large (rendezvous) message only moves while its sender is inside MPI: a send left
-                # pending while this rank solves its next surface kept rank 0 spinning in that recv for the
-                # whole surface (half the throughput of a 2-rank run). Test + sleep: no busy wait here either.
+                # Stay until rank 0 has taken the record: a large (rendezvous) message only moves while its
+                # sender is inside MPI, and a send left pending during the next surface kept rank 0 spinning
+                # in its recv for that whole surface. Test + sleep: no busy wait here either.
                 request = self.comm.isend(record, dest=0, tag=TAG_RECORD)
                 while not request.Test():
                     time.sleep(IDLE_SLEEP)
@@ -305,7 +294,7 @@ class Ensemble:
 
 
 def run(reader, comm):
-    """Entry point of ``python -m roughpetsc -mode ensemble``; returns the exit status (0, or 3 if a step failed)."""
+    """``-mode ensemble``; returns the exit status (0, or 3 if a step failed)."""
     from ..app.options import check_unused
 
     s = ensemble_settings.read_settings(reader, comm.Get_size())

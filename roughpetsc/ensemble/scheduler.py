@@ -12,9 +12,8 @@ IDLE_SLEEP = 0.01          # seconds between looks for messages when a rank has 
 class WorkCounter:
     """The next work item for the group leaders: an atomic counter on world rank 0.
 
-    One-sided (``MPI.Win.Allocate`` + ``Fetch_and_op``) when the MPI library
-    supports it; otherwise leaders ask rank 0 by message and rank 0 answers in
-    :meth:`roughpetsc.ensemble.runner.Ensemble.poll` (between its load steps).
+    One-sided (``Fetch_and_op`` on a window) where MPI supports it; otherwise by messages rank 0 answers
+    between its load steps (:meth:`roughpetsc.ensemble.runner.Ensemble.poll`).
     """
 
     def __init__(self, comm, items, use_window=True):
@@ -57,10 +56,7 @@ class WorkCounter:
         return k if k < len(self.items) else -1
 
     def exhaust(self):
-        """Rank 0: no more items for anybody (the run stops after the surfaces under way).
-
-        Returns how many items had been handed out.
-        """
+        """Rank 0: no more items for anybody; returns how many had been handed out."""
         from mpi4py import MPI
 
         handed = self.next_local

@@ -34,12 +34,8 @@ NOT_CONFIG = ("monitor", "view", "log", "converged_reason", "options_left", "inf
 
 @dataclass(frozen=True)
 class EnsembleSettings:
-    """Every option of the mode, read and checked (the same on all ranks).
-
-    ``loads`` are the p* of the steps (7.11 or a list), ``models`` the model names to store,
-    ``grid`` the :class:`roughpetsc.surfaces.Grid` and ``surface`` the fractal parameters
-    ``{"type", "N0", "N", "L", "kl", "ks", "H", "m2"}`` of every surface.
-    """
+    """Every option of the mode, read and checked (the same on all ranks); ``loads`` the p* of the steps,
+    ``surface`` the fractal parameters of every surface."""
 
     size: int
     seed: int
@@ -106,12 +102,9 @@ def read_settings(reader, ranks):
 
 
 def configuration(settings, solver_name):
-    """Everything that determines the numbers of a surface (a resumed file must match it).
-
-    The resolved surface, modulus, seed, loads and tolerance, the solver's name, and every other
-    option given (solver options such as ``-tao_*``, ``-pk_*``, ``-bound_pc``, ``-solve_max_time``)
-    except those that cannot change a surface's numbers (:data:`NOT_NUMBERS`, monitors, viewers, logs).
-    """
+    """Everything that determines the numbers of a surface (a resumed file must match it): the resolved surface,
+    modulus, seed, loads, tolerance and solver, and every other option given but monitors, viewers, logs and
+    :data:`NOT_NUMBERS`."""
     from petsc4py import PETSc
 
     resolved = ("E_star", "kkt_rtol", "ensemble_seed", "ensemble_loads", "tao_type")

@@ -1,12 +1,8 @@
 """What an ensemble file stores beside the surfaces: step statistics, the statistical models, kappa.
 
-* :func:`step_statistics`: mean and sample standard deviation (ddof = 1) over the surfaces of every
-  per-step quantity of :data:`STATISTICS`, in index order (so a resumed run gives the same numbers),
-  the count of converged steps, and the means and std of the surfaces' bandwidths.
-* :func:`compute_models`: the statistical models at the steps' p* with the ensemble's mean bandwidths
-  (the dissertation, sec. 7.3): early-contact models (ch. 4) on p* <= :data:`EARLY_PMAX`, where they
-  give the separation d* ~ g*; nearly-complete-contact models (ch. 5) everywhere; Persson's (5.59) and
-  App. E; and kappa = dA*/dp* of every curve and of the BEM means.
+The models are evaluated at the steps' p* with the ensemble's mean bandwidths (sec. 7.3): early-contact
+models (ch. 4) on p* <= :data:`EARLY_PMAX`, nearly-complete-contact models (ch. 5) everywhere, Persson's (5.59)
+and App. E, and kappa = dA*/dp* of every curve and of the BEM means.
 """
 
 import numpy as np
@@ -29,11 +25,10 @@ def _per_step(records, name, n_steps):
 
 
 def step_statistics(records, n_steps):
-    """Means and sample std (ddof = 1) over the surfaces, in the order of ``records``.
+    """Means and sample std (ddof = 1) over the surfaces, in the order of ``records`` (NaN where undefined).
 
-    Returns ``{"<q>_mean", "<q>_std": (n_steps,)}`` for q in :data:`STATISTICS`,
-    ``"converged_count"`` (n_steps,), and scalars ``"<a>_mean", "<a>_std"`` for a in
-    :data:`SURFACE_STATISTICS` (those every record has). NaN where undefined (no surface, or one).
+    ``<q>_mean``, ``<q>_std`` (n_steps,) of :data:`STATISTICS`, ``converged_count`` (n_steps,), and scalars of
+    the :data:`SURFACE_STATISTICS` every record has.
     """
     out = {}
     n = len(records)
@@ -89,25 +84,12 @@ def _complete_curves(pstar, alpha_p, alpha_h, name, notes):
 def compute_models(pstar, alpha_h, alpha_p, surface, E_star, names, statistics):
     """The statistical models at the steps' p* with the ensemble's mean bandwidths, and kappa = dA*/dp*.
 
-    Parameters
-    ----------
-    pstar : ndarray (m,)
-        The steps' p* = pbar / sqrt(m0^p), increasing.
-    alpha_h, alpha_p : float
-        The ensemble's mean bandwidths (2.16), (2.54).
-    surface : dict
-        The fractal parameters ``kl, ks, H, m2`` (Persson's gap, App. E).
-    E_star : float
-        Composite modulus E* (1.6).
-    names : iterable of str
-        The models to compute (:data:`MODEL_NAMES`).
-    statistics : dict
-        :func:`step_statistics` of the ensemble (kappa of the BEM means).
+    ``pstar``: the steps' increasing p* = pbar / sqrt(m0^p); ``alpha_h``, ``alpha_p``: mean bandwidths (2.16),
+    (2.54); ``surface``: the fractal ``kl, ks, H, m2`` (Persson's gap, App. E); ``E_star``: E* (1.6); ``names``:
+    of :data:`MODEL_NAMES`; ``statistics``: :func:`step_statistics` (kappa of the BEM means).
 
-    Returns
-    -------
-    dict ``{"pstar", "alpha_h", "alpha_p", "early_pmax", "early": {model: {"A", "dstar"}}, "complete": {model: {"A",
-    "gstar"}}, "persson": {"A", "gstar"} (if named), "kappa": {curve: (m,)}, "notes": {curve: why NaN}}``.
+    Returns ``{"pstar", "alpha_h", "alpha_p", "early_pmax", "early": {model: {"A", "dstar"}}, "complete":
+    {model: {"A", "gstar"}}, "persson": {"A", "gstar"}, "kappa": {curve: (m,)}, "notes": {curve: why NaN}}``.
     """
     from .. import models
 
@@ -134,8 +116,7 @@ def compute_models(pstar, alpha_h, alpha_p, surface, E_star, names, statistics):
 def stored_statistics(contents, say=print):
     """``{name: value}`` of ``/statistics`` of an ensemble file (a path or a :func:`roughpetsc.store.read` dict).
 
-    Quantities a format-1 file lacks are computed from its stored steps by :func:`step_statistics`
-    (the function that writes them), and ``say`` tells which.
+    Quantities a format-1 file lacks are computed from its steps, and ``say`` tells which.
     """
     from ..store import ensemble_file
 
@@ -152,11 +133,8 @@ def stored_statistics(contents, say=print):
 
 
 def stored_models(contents, statistics=None, say=print):
-    """The ``/models`` of an ensemble file as the dict :func:`compute_models` returns.
-
-    A file without models (an unfinished ensemble) gets them computed from its statistics and
-    configuration by :func:`compute_models` (every model), and ``say`` tells so.
-    """
+    """The ``/models`` of an ensemble file as :func:`compute_models` returns them; computed (every model) for an
+    unfinished ensemble, and ``say`` tells so."""
     import json
 
     from ..store import ensemble_file

@@ -1,15 +1,9 @@
 """The one HDF5 store of roughpetsc: one atomic writer, and one schema and one reader per file kind.
 
-File kinds (each module holds its layout, its writer and its reader):
-
-* :mod:`roughpetsc.store.path_file`: ``-mode solve -output``, a load path as its steps finish;
-* :mod:`roughpetsc.store.stats_file`: ``-mode stats -stats_h5``, surface statistics of one surface or an ensemble;
-* :mod:`roughpetsc.store.ensemble_file`: ``-mode ensemble -output``, BEM solves of many surfaces, resumable.
-
-Every file records the options and versions that made it (:func:`roughpetsc.store.outputs.provenance`).
-
-Writing: atomically, by :func:`write` (rank 0) or :func:`write_distributed` (every rank its rows of the
-fields, parallel HDF5); how, and why: docs/runtime.md.
+File kinds: :mod:`~roughpetsc.store.path_file` (``-mode solve -output``), :mod:`~roughpetsc.store.stats_file`
+(``-mode stats -stats_h5``), :mod:`~roughpetsc.store.ensemble_file` (``-mode ensemble -output``). Every file
+records the options and versions that made it. Writing is atomic, by :func:`write` (rank 0) or
+:func:`write_distributed` (every rank its rows, parallel HDF5); how and why: docs/runtime.md.
 """
 
 from io import BytesIO
@@ -21,26 +15,24 @@ from .outputs import atomic_path, jsonable
 
 
 def write(path, build, deferred=None):
-    """Write an HDF5 file atomically and durably: ``build(h5file)`` fills it in memory first.
+    """Write an HDF5 file atomically and durably: ``build(h5file)`` fills an empty ``h5py.File`` in memory first.
 
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The file to create or replace.
-    build : callable
-        Called with an open, empty, writable ``h5py.File``; whatever it writes is the file.
-    deferred : list, optional
-        The written temporary joins it instead of replacing ``path`` (:class:`roughpetsc.store.outputs.atomic_path`).
-
-    Raises :class:`roughpetsc.errors.UserError` naming ``path`` if the file cannot be written.
+    ``deferred``: as for :class:`roughpetsc.store.outputs.atomic_path`. Raises :class:`UserError` naming ``path``
+    if the file cannot be written.
     """
+    image = _image(build)
+    with atomic_path(path, durable=True, deferred=deferred) as temporary, open(temporary, "wb") as handle:
+        handle.write(image.getbuffer())
+
+
+def _image(build):
+    """The HDF5 file that ``build`` writes, in memory."""
     import h5py
 
     image = BytesIO()
     with h5py.File(image, "w") as f:
         build(f)
-    with atomic_path(path, durable=True, deferred=deferred) as temporary, open(temporary, "wb") as handle:
-        handle.write(image.getbuffer())
+    return image
 
 
 def parallel_hdf5(comm):
@@ -51,21 +43,11 @@ def parallel_hdf5(comm):
 
 
 def write_distributed(path, comm, build, distributed, deferred=None):
-    """Write an HDF5 file atomically from every rank of ``comm``: :func:`write`, with datasets spread over the ranks.
+    """:func:`write` from every rank of ``comm`` (:func:`parallel_hdf5`), with datasets spread over the ranks.
 
-    Parameters
-    ----------
-    path, build :
-        As for :func:`write`; ``build`` runs on rank 0 and must create each dataset of ``distributed``
-        empty (its shape and type; no compression, which parallel writes do not allow here).
-    comm : mpi4py.MPI.Comm
-        Every rank calls this function (:func:`parallel_hdf5` is True).
-    distributed : dict of name -> (local rows, first row)
-        Each rank's block of rows of a dataset, written collectively.
-    deferred : list, optional
-        As for :func:`write`, on rank 0.
-
-    Raises :class:`roughpetsc.errors.UserError` naming ``path``, on every rank, if the file cannot be written.
+    ``build`` runs on rank 0 and must create each dataset of ``distributed`` (name -> (local rows, first row))
+    empty, uncompressed; each rank's rows are then written collectively. Raises :class:`UserError` naming
+    ``path`` on every rank if the file cannot be written.
     """
     import h5py
 
@@ -74,9 +56,7 @@ def write_distributed(path, comm, build, distributed, deferred=None):
     target, temporary, message = None, None, None
     if comm.Get_rank() == 0:
         try:
-            image = BytesIO()
-            with h5py.File(image, "w") as f:
-                build(f)
+            image = _image(build)
             target = atomic_path(path, durable=True, deferred=deferred)
             temporary = target.__enter__()
             with open(temporary, "wb") as handle:

@@ -18,9 +18,7 @@ HDF5 layout (``n`` finished surfaces in index order, ``m`` load steps)::
         pstar (m,); early/<model>/{A, dstar} (NaN above p* = 0.2); complete/<model>/{A, gstar};
         persson/{A, gstar}; kappa/<curve> = dA*/dp*; attrs alpha_h, alpha_p, early_pmax, notes
 
-Format ``roughpetsc-ensemble-2`` added the finite-difference bandwidths and the rms gap statistics to
-format 1; a format-1 file reads (:func:`roughpetsc.ensemble.statistics.stored_statistics` completes
-what it lacks) but does not resume.
+A format-1 file (without the finite-difference bandwidths and rms gap statistics) reads but does not resume.
 """
 
 import json
@@ -55,10 +53,7 @@ MODELS_CONVENTIONS = "p* = pbar/sqrt(m0^p), g* = gbar/sqrt(m0^h), d* = d/sqrt(m0
 
 
 def step_row(result):
-    """The values of :data:`STEP_COLUMNS` of one solve (a :class:`roughpetsc.contact.Result`), as floats.
-
-    A missing load error (displacement control) is NaN; ``converged`` is 1 or 0.
-    """
+    """The values of :data:`STEP_COLUMNS` of a :class:`roughpetsc.contact.Result` as floats (None as NaN)."""
     row = []
     for _, attribute in STEP_COLUMNS:
         value = operator.attrgetter(attribute)(result)
@@ -94,9 +89,8 @@ def _write_models(group, models):
 def write(path, attrs, pstar_target, records, statistics, models=None):
     """Write the whole ensemble file atomically (:func:`roughpetsc.store.write`).
 
-    ``records`` are ``{"surface": {field: value}, "steps": {field: (m,)}, "reason": [str] * m}`` in any
-    order (stored in index order); ``statistics`` is their step statistics, ``models`` (or None) the
-    models of :func:`roughpetsc.ensemble.statistics.compute_models` with ``early_pmax``.
+    ``records``: ``{"surface": {field: value}, "steps": {field: (m,)}, "reason": [str] * m}`` in any order;
+    ``models``: those of :func:`roughpetsc.ensemble.statistics.compute_models`, or None.
     """
     import h5py
 
@@ -139,8 +133,7 @@ def _records_from(surfaces, steps, reasons):
 
 
 def stored_config(config, options):
-    """The configuration JSON of a file, as a dict; a file written before the fractal surface's generator was part
-    of it gets the generator its options JSON records (``-surface_generator``, else the option's default)."""
+    """The configuration JSON of a file as a dict; an older file's fractal surface gets the generator of its options."""
     from ..surface.generators import DEFAULT_GENERATOR
 
     config = json.loads(config)
@@ -154,8 +147,7 @@ def stored_config(config, options):
 def read_records(path, config):
     """Finished surfaces of an existing ensemble file (checked against ``config``), its run log and FFTW wisdom.
 
-    Raises :class:`UserError` naming ``-output`` if the file is not an ensemble file of this format,
-    cannot be read, or was made by another configuration.
+    Raises :class:`UserError` naming ``-output`` for another file, format or configuration, or a failed read.
     """
     import h5py
 
@@ -240,11 +232,9 @@ def _difference(contents, name, x, y):
 def compare(a, b):
     """The largest scaled difference of each quantity of two ensemble files (paths or :func:`read` dicts).
 
-    :data:`VOLATILE` entries, the command and the options are left out. A difference is divided by
-    the largest magnitude of its dataset (a standard deviation by that of its mean); the scale-free
-    KKT residuals, which are round-off noise at a solution, are compared absolutely, and the rms gap
-    in contact relative to sqrt(m0^h). Different names, shapes, NaN patterns, integers or strings
-    count as ``inf``. "Equal to 1e-12" means every value is <= 1e-12.
+    :data:`VOLATILE` entries, the command and the options are left out. A difference is divided by the largest
+    magnitude of its dataset (a std by that of its mean); KKT residuals are compared absolutely, the rms gap in
+    contact relative to sqrt(m0^h). Different names, shapes, NaN patterns, integers or strings count as ``inf``.
     """
     a, b = flat(a), flat(b)
     skip = set(VOLATILE) | {"@command", "@options"}

@@ -50,8 +50,7 @@ def provenance():
 def check_writable(path, option):
     """Fail early, naming the option, if a file cannot be written at ``path``.
 
-    Refused: a folder, a folder that does not exist or takes no new file (tried by creating one, which also catches
-    read-only file systems and root), an existing file without write permission.
+    Refused: a folder, a missing folder or one that takes no new file (tried), a file without write permission.
     """
     if os.path.isdir(path):
         raise UserError(f"-{option} {path}: is a folder; give a file name")
@@ -87,8 +86,6 @@ def check_outputs(outputs, overwrite=False, inputs=(), may_exist=()):
         Files the run reads: never an output, even with ``-overwrite``.
     may_exist : iterable of option names
         Outputs that are meant to exist already (a file to resume).
-
-    Raises :class:`UserError` naming the option and the file.
     """
     written = []
     for option, path in outputs:
@@ -119,9 +116,8 @@ def check_figure_format(path, option):
 def on_root(comm, action, *args):
     """Run ``action(*args)`` on rank 0 only; its :class:`UserError` is raised on every rank.
 
-    What only rank 0 does (checking or writing files) must not fail there alone: the other ranks would wait for
-    ever in their next collective call. The error message is broadcast, so every rank raises the same error (and
-    all ranks leave together). Returns the result on rank 0, None elsewhere.
+    Otherwise the other ranks would wait for ever in their next collective call. Returns the result on rank 0,
+    None elsewhere.
     """
     result, message = None, None
     if comm is None or comm.Get_rank() == 0:
@@ -146,10 +142,9 @@ def file_mode():
 class atomic_path:
     """Context manager giving a temporary path (same folder, same suffix) that replaces ``path`` on success only.
 
-    The file gets the mode of any new file (:func:`file_mode`; mkstemp's would be 0600). ``durable``: fsync the
-    file and its folder, so that a crash right after leaves the old or the new file, whole. ``deferred``: a list; on
-    success the written temporary joins it instead of replacing ``path``, for the caller to :meth:`replace` several
-    files at once (or :meth:`discard` them). A failure to write raises :class:`UserError` naming ``path``.
+    The file gets the mode of any new file (mkstemp's would be 0600). ``durable``: fsync the file and its folder,
+    so a crash leaves the old or the new file, whole. ``deferred``: a list the written temporary joins instead of
+    replacing ``path``, for the caller to :meth:`replace` or :meth:`discard`. Failures raise :class:`UserError`.
     """
 
     def __init__(self, path, durable=False, deferred=None):
@@ -213,10 +208,7 @@ def _os_reason(error):
 
 
 def remove_stale_temporaries(path):
-    """Delete the temporaries of :class:`atomic_path` for ``path`` that a killed run left behind.
-
-    Call only where no other run may be writing ``path`` (a resumed ensemble or load path).
-    """
+    """Delete the temporaries of :class:`atomic_path` for ``path`` a killed run left (no other run may write it)."""
     folder = os.path.dirname(os.path.abspath(path))
     suffix = os.path.basename(path)
     for name in os.listdir(folder):
@@ -249,8 +241,7 @@ def jsonable(value):
 
 
 def write_json(path, data, deferred=None):
-    """Write ``data`` as indented JSON, atomically (the one JSON writer of every mode); ``deferred``: as for
-    :class:`atomic_path`."""
+    """Write ``data`` as indented JSON, atomically; ``deferred``: as for :class:`atomic_path`."""
     with atomic_path(path, deferred=deferred) as temporary:
         with open(temporary, "w") as f:
             json.dump(jsonable(data), f, indent=2)

@@ -63,13 +63,12 @@ def write(path, summary, fields=None, histories=None, step_fields=None, stresses
     step_fields : dict of step index -> {name: ndarray}, optional
         Fields kept per step (``-output_fields all``).
     stresses : sequence of roughpetsc.stresses.DepthStresses
-        The last step's subsurface stresses, one entry per depth (``-stress_depths``).
+        The last step's subsurface stresses, one per depth.
     comm, first_row :
-        With ``first_row`` (this rank's first row), the pressure and gap fields of ``fields`` and
-        ``step_fields`` are this rank's rows only, and every rank of ``comm`` calls this function: the
-        fields are written in parallel (:func:`roughpetsc.store.write_distributed`); ``heights`` is whole.
+        With ``first_row``, pressure and gap are this rank's rows from it on, and every rank of ``comm`` calls
+        this function (:func:`roughpetsc.store.write_distributed`); ``heights`` is whole.
     deferred : list, optional
-        The written temporary joins it instead of replacing ``path`` (:func:`roughpetsc.store.write`).
+        As for :func:`roughpetsc.store.write`.
     """
     distributed = {}
     if first_row is not None:
@@ -115,9 +114,8 @@ def write(path, summary, fields=None, histories=None, step_fields=None, stresses
 def read(path):
     """A load path's file: ``{"attrs", "heights", "last_fields", "steps"}``, or None if it is not one.
 
-    ``attrs`` are the root attributes as stored (JSON text left as text, so they compare with
-    :func:`differs_from`); each entry of ``steps`` is ``{"summary", "history", "fields"}`` in step order.
-    Raises ``OSError`` if the file cannot be opened as HDF5.
+    ``attrs``: the root attributes as stored (JSON as text); ``steps``: ``{"summary", "history", "fields"}`` in
+    step order. Raises ``OSError`` if the file cannot be opened as HDF5.
     """
     import h5py
 

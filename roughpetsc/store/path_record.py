@@ -1,11 +1,8 @@
 """The record of a solve-mode run as its load steps finish: what ``-output``, ``-output_fields`` and ``-resume`` keep.
 
-A load path is written to its HDF5 file after its steps (atomically, see
-:mod:`roughpetsc.store`; the layout is :mod:`roughpetsc.store.load_path`), so a run
-interrupted by Ctrl-C, a batch time limit or a step that ran out of
-``-solve_max_time`` keeps its finished steps, and ``-resume`` continues it: the
-steps recorded for the same problem and the same loads are taken from the file,
-the next load starts from the last saved pressure field.
+The file (:mod:`roughpetsc.store.path_file`) is rewritten atomically after the steps, so an interrupted run
+keeps its finished steps, and ``-resume`` takes those of the same problem and loads from the file and starts
+the next load from the last saved pressure.
 """
 
 import time
@@ -34,9 +31,8 @@ class PathRecord:
     keep : one of OUTPUT_FIELDS
         ``-output_fields``: pressure and gap of every step, of the last step, or none.
     first_row, local_rows : int or None
-        None: the fields given to :meth:`add` are whole (rank 0). Else they are this rank's
-        ``local_rows`` rows from ``first_row`` on, and every rank writes its rows of the file
-        (:meth:`write` with ``comm``).
+        None: the fields given to :meth:`add` are whole (rank 0); else this rank's ``local_rows`` rows from
+        ``first_row`` on, which every rank writes (:meth:`write` with ``comm``).
     """
 
     def __init__(self, summary, heights, keep, first_row=None, local_rows=None):
@@ -69,10 +65,8 @@ class PathRecord:
     def write(self, h5_path, json_path, requests, comm=None):
         """Write the files of the steps so far, each atomically, and replace them together; True if they were.
 
-        On rank 0 alone, or, for a record of distributed fields (``first_row``), on every rank of
-        ``comm`` (the JSON by rank 0). ``requests``: the :class:`roughpetsc.app.interrupts.StopRequests`
-        of the run; once a stop was requested no file is replaced (what the files hold is what the run's
-        closing line says).
+        On rank 0, or with distributed fields on every rank of ``comm`` (the JSON by rank 0). Once a stop was
+        requested (``requests``, :class:`roughpetsc.app.interrupts.StopRequests`) no file is replaced.
         """
         start = time.perf_counter()
         distributed = self.first_row is not None
@@ -100,25 +94,15 @@ class PathRecord:
         return replaced
 
     def due(self):
-        """True when a checkpoint after this step keeps the writing under a fifth of the run time.
-
-        A rewrite costs more as the steps accumulate (``-output_fields all``);
-        between two writes at least four times the last write's duration passes.
-        """
+        """True when a checkpoint now keeps the writing under a fifth of the run time (rewrites grow with the steps)."""
         return time.perf_counter() - self.written_at >= 4.0 * self.write_seconds
 
     def resume_from(self, path, loads, load_option):
         """Take from ``path`` the steps of ``loads`` it solved for the same problem.
 
-        ``loads`` is the list of ``(kind, value)`` of this run, given by ``-load_option``. The loads
-        saved in the file must be the first loads of this run (a longer list extends the path):
-        otherwise resuming would lose saved steps, and the run is refused, naming them. The
-        converged steps are taken up to the first that did not converge, which is solved again with
-        all after it. Returns the whole pressure field (pressure units) to start the next load from
-        (that of the last step taken, else the last one saved), or None.
-
-        Raises :class:`UserError` if the file records another problem (surface, grid, E*, solver,
-        control or tolerance) or other loads.
+        ``loads``: this run's ``(kind, value)`` of ``-load_option``; the saved loads must begin them. Steps are
+        taken up to the first that did not converge. Returns the whole pressure (pressure units) to start the
+        next load from, or None. Raises :class:`UserError` for another problem or other loads.
         """
         try:
             stored = load_path.read(path)
@@ -161,10 +145,7 @@ def describe_loads(loads):
 
 
 def check_continuation(path, saved, loads, load_option):
-    """Refuse a resumed run whose loads do not begin with the ``saved`` ones: it would drop saved steps.
-
-    ``saved`` and ``loads`` are lists of ``(kind, value)``; ``load_option`` names the option of ``loads``.
-    """
+    """Refuse a resumed run whose loads ``(kind, value)`` do not begin with the ``saved`` ones."""
     loads = [(kind, float(value)) for kind, value in loads]
     saved = [(kind, float(value)) for kind, value in saved]
     if loads[:len(saved)] == saved:

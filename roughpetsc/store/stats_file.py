@@ -52,11 +52,7 @@ def write(path, document):
 
 
 def read(path):
-    """A stats file as the parts of the result document it holds (numbers as numpy values).
-
-    Returns ``{"settings", "surface_options", "versions", "grid", "conventions", "seeds", "mean",
-    "std", "closed_form", "per_surface", "histogram_edges", "histogram_density", "pdf_l1"}``.
-    """
+    """A stats file as the parts of the result document it holds (numbers as numpy values)."""
     import h5py
 
     with h5py.File(path, "r") as f:
