@@ -65,7 +65,8 @@ from .options import _petsc_library, default_options, set_from_options
 from .preconditioner import MEAN_MODE_WEIGHT, FourierPreconditioner
 from .protocol import Backend, Outcome
 from .registry import register
-from .stopping import DEFAULT_MAX_IT, ConvergenceTest, History, Verdict, describe_stop, option_name
+from .stopping import (DEFAULT_MAX_IT, ConvergenceTest, History, Verdict, describe_stop, option_name,
+                       read_option)
 
 BOUND_TYPES = ("blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bqnktl", "bnls", "bntr", "bntl", "tron", "gpcg")
 # Types whose Newton step is a KSP solve on the free set: they take the Fourier preconditioner. It is their
@@ -423,12 +424,12 @@ class BoundQP(Backend):
         options = PETSc.Options(settings.prefix)
         h0 = options.getString("bound_h0", "") or ("fourier" if tao_type in QUASI_NEWTON_TYPES else "none")
         quasi_newton_h0 = h0 == "fourier" and tao_type in QUASI_NEWTON_TYPES
-        self.penalty_factor = options.getReal("bound_al_penalty",
-                                              PENALTY_QUASI_NEWTON if quasi_newton_h0 else PENALTY_OTHERS)
-        self.eta = options.getReal("bound_al_eta", ETA_QUASI_NEWTON if quasi_newton_h0 else ETA_OTHERS)
-        self.max_outer = options.getInt("bound_al_max_outer", 40)
-        self.recycle = options.getBool("bound_al_recycle", False)
-        self.newton = options.getBool("bound_al_newton", True)
+        self.penalty_factor = read_option(options, "Real", "bound_al_penalty",
+                                          PENALTY_QUASI_NEWTON if quasi_newton_h0 else PENALTY_OTHERS)
+        self.eta = read_option(options, "Real", "bound_al_eta", ETA_QUASI_NEWTON if quasi_newton_h0 else ETA_OTHERS)
+        self.max_outer = read_option(options, "Int", "bound_al_max_outer", 40)
+        self.recycle = read_option(options, "Bool", "bound_al_recycle", False)
+        self.newton = read_option(options, "Bool", "bound_al_newton", True)
         preconditioner = options.getString("bound_pc", "") or \
             ("fourier" if tao_type in FOURIER_DEFAULT_TYPES else "none")
         self._check_options(h0, preconditioner)

@@ -43,9 +43,24 @@ def option_name(name, prefix=None):
     return f"-{prefix or ''}{name}"
 
 
+KIND_WORDS = {"Real": "a number", "Int": "an integer", "Bool": "true or false"}
+
+
+def read_option(options, kind, name, default):
+    """``options.get<kind>(name, default)`` (kind: Real, Int or Bool); a value PETSc cannot read is refused by name.
+
+    PETSc's own message ("Input string abc has no numeric value") names neither the option nor its prefix.
+    """
+    try:
+        return getattr(options, "get" + kind)(name, default)
+    except PETSc.Error:
+        raise UserError(f"{option_name(name, options.prefix)}: cannot read the value '{options.getString(name, '')}' "
+                        f"as {KIND_WORDS[kind]}") from None
+
+
 def max_seconds(prefix=None):
     """``-solve_max_time`` under ``prefix``: seconds after which a solve stops (0: no limit)."""
-    seconds = PETSc.Options(prefix).getReal("solve_max_time", 0.0)
+    seconds = read_option(PETSc.Options(prefix), "Real", "solve_max_time", 0.0)
     if not seconds >= 0:
         raise UserError(f"{option_name('solve_max_time', prefix)} must be a non-negative number of seconds, "
                         f"got {seconds}")
