@@ -381,9 +381,11 @@ def contact_stiffness(problem, pressure, preconditioner, rtol=1e-2, max_it=30):
             v.destroy()
 
 
-def next_multiplier(points, pbar, separation, stiffness=None):
+def next_multiplier(points, pbar, separation, stiffness=None, touch=None):
     """The next lambda: a secant step on the (d, log P) pairs, inside their bracket; the first a Newton step with
-    the contact ``stiffness`` (the multiplier update, lambda <- d, without one).
+    the contact ``stiffness`` (the multiplier update, lambda <- d, without one). After a solution out of contact
+    (P = 0, where log P has no slope), ``touch``: the separation at which its surfaces touch, an upper bound of
+    the root (lambda <- d moves by only c pbar there).
 
     P(d) decreases with d, like exp(-d / l) at small loads (Bush, Gibson and Thomas), so log P is closer to
     linear in d than P, and the steps are taken on it. A pair with P > pbar lies below the root, one with
@@ -394,7 +396,9 @@ def next_multiplier(points, pbar, separation, stiffness=None):
     low = max(below) if below else -math.inf
     high = min(above) if above else math.inf
     d1, p1 = points[-1]
-    if len(points) < 2:
+    if p1 == 0 and touch is not None:
+        step = touch
+    elif len(points) < 2:
         if not stiffness or not p1 > 0:
             return separation  # the method of multipliers: lambda <- d
         step = d1 + math.log(p1 / pbar) * p1 / stiffness  # d log P / dd = -k / P
@@ -545,6 +549,11 @@ class BoundQP(Backend):
             test.watch.restart(test.iteration_offset - 1)
             self.buffers[self.best].copy(pressure)
 
+    def _touch(self, pressure):
+        """The separation at which the surfaces touch, for ``pressure`` out of contact (its gap is d - h)."""
+        gap, _, separation = self.objective.cached_gap(pressure)
+        return separation - allmin(self.problem.mpi, [gap.min()])[0]
+
     def _project(self, pressure):
         local = self.problem.local(pressure)
         np.maximum(local, 0.0, out=local)
@@ -607,7 +616,7 @@ class BoundQP(Backend):
                 break
             stiffness = contact_stiffness(problem, pressure, self.stiffness_preconditioner) \
                 if len(points) == 1 and self.newton else None
-            lam = next_multiplier(points, pbar, separation, stiffness)
+            lam = next_multiplier(points, pbar, separation, stiffness, self._touch(pressure) if mean_p == 0 else None)
         note = f"{len(points)} inner solve{'s' * (len(points) > 1)}"
         reason = self.tao.getConvergedReason()
         if test.verdict is Verdict.CONVERGED:

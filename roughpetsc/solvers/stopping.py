@@ -166,17 +166,18 @@ class Watch:
         Whether the last :meth:`assess` found a new best (the backend may then keep a copy).
     stopped_by : str or None
         ``"time limit"`` or ``"stagnation"`` when the watch ended the solve so.
-    inner_eta : float
+    inner_eta : float or None
         An inner solve of an outer iteration on the load (an augmented Lagrangian) is done once its natural
-        residual is at most ``inner_eta`` times its load error (``INNER_DONE``); 0: every solve is solved to
-        the tolerance.
+        residual is at most ``inner_eta`` times its load error, capped at 1 (``INNER_DONE``; the
+        :class:`ConvergenceTest` asks for one step first). 0: only an exact solution of the inner problem ends
+        it short of the tolerance (TAO's BNLS, asked to go on from one, never returned). None: not an inner solve.
     """
 
     def __init__(self, rule, history, max_iterations=DEFAULT_MAX_IT):
         self.rule = rule
         self.history = history
         self.max_iterations = max_iterations
-        self.inner_eta = 0.0
+        self.inner_eta = None
         self.best_natural = np.inf
         self.best_iteration = 0
         self.improved = False
@@ -203,7 +204,7 @@ class Watch:
         self.history.record(iteration, natural)
         if merit < self.best_natural:
             self.best_natural, self.best_iteration, self.improved = merit, iteration, True
-        if self.inner_eta and load_error is not None and natural <= self.inner_eta * load_error:
+        if self.inner_eta is not None and load_error is not None and natural <= self.inner_eta * min(load_error, 1.0):
             return Verdict.INNER_DONE
         if iteration >= self.max_iterations:
             return Verdict.MAX_ITERATIONS
@@ -242,8 +243,11 @@ class ConvergenceTest:
         natural, load_error, fresh = self.evaluate(tao)
         iteration = tao.getIterationNumber()
         self.watch.max_iterations = tao.getMaximumIterations() + self.iteration_offset
-        verdict = self.verdict = self.watch.assess(iteration + self.iteration_offset, natural, load_error, fresh,
-                                                   self.confirm)
+        verdict = self.watch.assess(iteration + self.iteration_offset, natural, load_error, fresh, self.confirm)
+        if verdict is Verdict.INNER_DONE and iteration == 0 and natural > 0:
+            # The start of an inner solve is the last one's pressure at a new multiplier: not a point of P(d).
+            verdict = Verdict.CONTINUE
+        self.verdict = verdict
         if verdict is Verdict.CONFIRM:
             return PETSc.TAO.Reason.CONTINUE_ITERATING
         if self.watch.improved and self.keep_best is not None:
