@@ -1,5 +1,6 @@
 """Shared test set-up: PETSc initialised once; helpers to run the command line."""
 
+import faulthandler
 import os
 import pty
 import subprocess
@@ -24,6 +25,33 @@ def pytest_configure(config):
 def pytest_report_header(config):
     effort = os.environ.get("ROUGHPETSC_FFT_EFFORT") or "as each test asks"
     return f"roughpetsc: FFTW planner effort {effort}, wisdom cache {os.environ['ROUGHPETSC_FFT_WISDOM']}"
+
+# A test still running after this many seconds ends the whole run, with every thread's traceback (which names
+# the test) on stderr: a hang inside the test process, even one in C code that never returns to Python, must not
+# run on to CI's limit. The longest test takes about 3 minutes on a loaded two-core machine.
+TEST_TIME_LIMIT = float(os.environ.get("ROUGHPETSC_TEST_TIME_LIMIT", 900))
+TERMINAL_STDERR = pytest.StashKey[int]()
+
+
+def _terminal_stderr(config):
+    """A copy of the stderr that pytest's output capture replaces during a test (where a traceback would be lost)."""
+    capture = config.pluginmanager.getplugin("capturemanager")
+    if capture is None:
+        return os.dup(2)
+    with capture.global_and_fixture_disabled():
+        return os.dup(2)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    if TERMINAL_STDERR not in item.config.stash:
+        item.config.stash[TERMINAL_STDERR] = _terminal_stderr(item.config)
+    faulthandler.dump_traceback_later(TEST_TIME_LIMIT, exit=True, file=item.config.stash[TERMINAL_STDERR])
+    try:
+        yield
+    finally:
+        faulthandler.cancel_dump_traceback_later()
+
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",

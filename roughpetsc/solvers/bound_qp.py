@@ -19,7 +19,8 @@ from .options import _petsc_library, default_options, set_from_options
 from .preconditioner import MEAN_MODE_WEIGHT, FourierPreconditioner
 from .protocol import Backend, Outcome
 from .registry import register
-from .stopping import DEFAULT_MAX_IT, ConvergenceTest, History, Verdict, describe_stop, option_name
+from .stopping import (DEFAULT_MAX_IT, ConvergenceTest, History, Verdict, describe_stop, option_name,
+                       read_option)
 
 BOUND_TYPES = ("blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bqnktl", "bnls", "bntr", "bntl", "tron", "gpcg")
 # Types whose Newton step is a KSP solve on the free set: they take the Fourier preconditioner. It is their
@@ -310,17 +311,20 @@ def contact_stiffness(problem, pressure, preconditioner, rtol=1e-2, max_it=30):
             v.destroy()
 
 
-def next_multiplier(points, pbar, separation, stiffness=None):
+def next_multiplier(points, pbar, separation, stiffness=None, touch=None):
     """The next lambda: a secant step on the (d, log P) pairs, inside their bracket; the first a Newton step with
     the contact ``stiffness`` (lambda <- d without one). log P is nearly linear in d at small loads (P ~ exp(-d/l),
-    Bush, Gibson and Thomas).
+    Bush, Gibson and Thomas). After a solution out of contact (P = 0: no slope of log P), ``touch``, the separation
+    at which its surfaces touch, an upper bound of the root (lambda <- d moves by only c pbar there).
     """
     below = [d for d, p in points if p > pbar]
     above = [d for d, p in points if p < pbar]
     low = max(below) if below else -math.inf
     high = min(above) if above else math.inf
     d1, p1 = points[-1]
-    if len(points) < 2:
+    if p1 == 0 and touch is not None:
+        step = touch
+    elif len(points) < 2:
         if not stiffness or not p1 > 0:
             return separation  # the method of multipliers: lambda <- d
         step = d1 + math.log(p1 / pbar) * p1 / stiffness  # d log P / dd = -k / P
@@ -347,12 +351,12 @@ class BoundQP(Backend):
         options = PETSc.Options(settings.prefix)
         h0 = options.getString("bound_h0", "") or ("fourier" if tao_type in QUASI_NEWTON_TYPES else "none")
         quasi_newton_h0 = h0 == "fourier" and tao_type in QUASI_NEWTON_TYPES
-        self.penalty_factor = options.getReal("bound_al_penalty",
-                                              PENALTY_QUASI_NEWTON if quasi_newton_h0 else PENALTY_OTHERS)
-        self.eta = options.getReal("bound_al_eta", ETA_QUASI_NEWTON if quasi_newton_h0 else ETA_OTHERS)
-        self.max_outer = options.getInt("bound_al_max_outer", 40)
-        self.recycle = options.getBool("bound_al_recycle", False)
-        self.newton = options.getBool("bound_al_newton", True)
+        self.penalty_factor = read_option(options, "Real", "bound_al_penalty",
+                                          PENALTY_QUASI_NEWTON if quasi_newton_h0 else PENALTY_OTHERS)
+        self.eta = read_option(options, "Real", "bound_al_eta", ETA_QUASI_NEWTON if quasi_newton_h0 else ETA_OTHERS)
+        self.max_outer = read_option(options, "Int", "bound_al_max_outer", 40)
+        self.recycle = read_option(options, "Bool", "bound_al_recycle", False)
+        self.newton = read_option(options, "Bool", "bound_al_newton", True)
         preconditioner = options.getString("bound_pc", "") or \
             ("fourier" if tao_type in FOURIER_DEFAULT_TYPES else "none")
         self._check_options(h0, preconditioner)
@@ -467,6 +471,11 @@ class BoundQP(Backend):
             test.watch.restart(test.iteration_offset - 1)
             self.buffers[self.best].copy(pressure)
 
+    def _touch(self, pressure):
+        """The separation at which the surfaces touch, for ``pressure`` out of contact (its gap is d - h)."""
+        gap, _, separation = self.objective.cached_gap(pressure)
+        return separation - allmin(self.problem.mpi, [gap.min()])[0]
+
     def _project(self, pressure):
         local = self.problem.local(pressure)
         np.maximum(local, 0.0, out=local)
@@ -528,7 +537,7 @@ class BoundQP(Backend):
                 break
             stiffness = contact_stiffness(problem, pressure, self.stiffness_preconditioner) \
                 if len(points) == 1 and self.newton else None
-            lam = next_multiplier(points, pbar, separation, stiffness)
+            lam = next_multiplier(points, pbar, separation, stiffness, self._touch(pressure) if mean_p == 0 else None)
         note = f"{len(points)} inner solve{'s' * (len(points) > 1)}"
         reason = self.tao.getConvergedReason()
         if test.verdict is Verdict.CONVERGED:

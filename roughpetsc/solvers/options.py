@@ -41,7 +41,20 @@ def set_from_options(tao, cleanup):
     except PETSc.Error as error:
         cleanup()
         lines = [line.split("]", 1)[-1].strip() for line in str(error).splitlines() if line.strip()]
-        raise UserError(f"a solver option was refused by PETSc: {lines[-1]}") from None
+        raise UserError(f"{_options_holding(lines[-1]) or 'a solver option'} was refused by PETSc: "
+                        f"{lines[-1]}") from None
+
+
+def _options_holding(message):
+    """The options (``-name``, comma-separated) whose value is the one PETSc's ``message`` quotes, or ''.
+
+    PETSc's message on an unreadable value quotes the value but not the option that held it.
+    """
+    quoted = re.search(r"Input string (.*) has no|Unknown logical value: (.*)$", message)
+    if quoted is None:
+        return ""
+    value = quoted.group(1) if quoted.group(1) is not None else quoted.group(2)
+    return ", ".join("-" + name for name, given in PETSc.Options().getAll().items() if given == value)
 
 
 @contextmanager

@@ -9,7 +9,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..errors import UserError
-from .stopping import ConvergenceTest, History, Verdict, check_convergence, option_name
+from .stopping import ConvergenceTest, History, Verdict, check_convergence, option_name, read_option
 from ..contact.certificate import KKTReport
 from ..parallel import allmax, allsum
 from .preconditioner import FourierPreconditioner
@@ -59,10 +59,9 @@ class PolonskyKeer:
         self.preconditioner = options.getString("pk_pc", self.preconditioner)
         self.active_set = options.getString("pk_active_set", self.active_set)
         try:
-            self.refresh = options.getInt("pk_refresh", self.refresh)
-        except PETSc.Error:
-            self.option_error = UserError(f"{option_name('pk_refresh', prefix)}: cannot read the value "
-                                          f"'{options.getString('pk_refresh', '')}' as an integer")
+            self.refresh = read_option(options, "Int", "pk_refresh", self.refresh)
+        except UserError as error:
+            self.option_error = error
             return
         if self.preconditioner not in PRECONDITIONERS:
             self.option_error = UserError(f"{option_name('pk_pc', prefix)}: unknown preconditioner "

@@ -33,9 +33,24 @@ def option_name(name, prefix=None):
     return f"-{prefix or ''}{name}"
 
 
+KIND_WORDS = {"Real": "a number", "Int": "an integer", "Bool": "true or false"}
+
+
+def read_option(options, kind, name, default):
+    """``options.get<kind>(name, default)`` (kind: Real, Int or Bool); a value PETSc cannot read is refused by name.
+
+    PETSc's own message ("Input string abc has no numeric value") names neither the option nor its prefix.
+    """
+    try:
+        return getattr(options, "get" + kind)(name, default)
+    except PETSc.Error:
+        raise UserError(f"{option_name(name, options.prefix)}: cannot read the value '{options.getString(name, '')}' "
+                        f"as {KIND_WORDS[kind]}") from None
+
+
 def max_seconds(prefix=None):
     """``-solve_max_time`` under ``prefix``: seconds after which a solve stops (0: no limit)."""
-    seconds = PETSc.Options(prefix).getReal("solve_max_time", 0.0)
+    seconds = read_option(PETSc.Options(prefix), "Real", "solve_max_time", 0.0)
     if not seconds >= 0:
         raise UserError(f"{option_name('solve_max_time', prefix)} must be a non-negative number of seconds, "
                         f"got {seconds}")
@@ -127,16 +142,17 @@ class Watch:
         Whether the last :meth:`assess` found a new best.
     stopped_by : str or None
         ``"time limit"`` or ``"stagnation"`` when the watch ended the solve so.
-    inner_eta : float
-        An inner solve of an augmented Lagrangian is done (``INNER_DONE``) once its natural residual is at
-        most ``inner_eta`` times its load error; 0: solved to the tolerance.
+    inner_eta : float or None
+        An inner solve of an augmented Lagrangian is done (``INNER_DONE``) once it has taken a step and its natural
+        residual is at most ``inner_eta`` times its load error capped at 1. 0: only an exact inner solution ends it
+        short of the tolerance (BNLS, asked to go on from one, never returned). None: not an inner solve.
     """
 
     def __init__(self, rule, history, max_iterations=DEFAULT_MAX_IT):
         self.rule = rule
         self.history = history
         self.max_iterations = max_iterations
-        self.inner_eta = 0.0
+        self.inner_eta = None
         self.best_natural = np.inf
         self.best_iteration = 0
         self.improved = False
@@ -162,7 +178,7 @@ class Watch:
         self.history.record(iteration, natural)
         if merit < self.best_natural:
             self.best_natural, self.best_iteration, self.improved = merit, iteration, True
-        if self.inner_eta and load_error is not None and natural <= self.inner_eta * load_error:
+        if self.inner_eta is not None and load_error is not None and natural <= self.inner_eta * min(load_error, 1.0):
             return Verdict.INNER_DONE
         if iteration >= self.max_iterations:
             return Verdict.MAX_ITERATIONS
@@ -198,8 +214,11 @@ class ConvergenceTest:
         natural, load_error, fresh = self.evaluate(tao)
         iteration = tao.getIterationNumber()
         self.watch.max_iterations = tao.getMaximumIterations() + self.iteration_offset
-        verdict = self.verdict = self.watch.assess(iteration + self.iteration_offset, natural, load_error, fresh,
-                                                   self.confirm)
+        verdict = self.watch.assess(iteration + self.iteration_offset, natural, load_error, fresh, self.confirm)
+        if verdict is Verdict.INNER_DONE and iteration == 0 and natural > 0:
+            # The start of an inner solve is the last one's pressure at a new multiplier: not a point of P(d).
+            verdict = Verdict.CONTINUE
+        self.verdict = verdict
         if verdict is Verdict.CONFIRM:
             return PETSc.TAO.Reason.CONTINUE_ITERATING
         if self.watch.improved and self.keep_best is not None:

@@ -43,6 +43,21 @@ def test_valueless_in_an_options_file_is_refused(tmp_path):
     assert_one_clear_error(out, "-gbar", "without a value")
 
 
+@pytest.mark.parametrize("args, named", [
+    (["-tao_type", "blmvm", "-bound_al_eta", "abc"], "-bound_al_eta"),   # was: PETSc's message, naming no option
+    (["-tao_type", "bqnls", "-bound_al_penalty", "1x"], "-bound_al_penalty"),
+    (["-tao_type", "blmvm", "-bound_al_max_outer", "1e3"], "-bound_al_max_outer"),
+    (["-tao_type", "blmvm", "-bound_al_recycle", "maybe"], "-bound_al_recycle"),
+    (["-solve_max_time", "x"], "-solve_max_time"),
+    (["-tao_max_it", "3.5"], "-tao_max_it"),                             # a PETSc option, read by TAO itself
+    (["-tao_type", "bnls", "-tao_bnk_max_cg_its", "q"], "-tao_bnk_max_cg_its"),
+])
+def test_an_unreadable_solver_option_is_refused_by_name(tmp_path, args, named):
+    out = run_cli(TINY + args + ["-json", "s.json"], cwd=tmp_path)
+    message = assert_one_clear_error(out, named, args[-1])
+    assert out.stdout == "" and not list(tmp_path.iterdir()), message
+
+
 @pytest.mark.parametrize("switch", [["-quiet"], ["-quiet", "1"], ["-quiet", "true"], ["-overwrite", "-quiet"]])
 def test_switches_stand_alone(tmp_path, switch):
     out = run_cli(TINY + switch + ["-json", tmp_path / "s.json"])

@@ -118,6 +118,13 @@ def test_contact_stiffness_matches_a_difference_of_pk_solves(reference):
     assert stiffness == pytest.approx(difference, rel=1e-3)
 
 
+def test_a_multiplier_out_of_contact_moves_to_where_the_surfaces_touch():
+    # P = 0 at d = 3: log P has no slope there, and lambda <- d would move by only c pbar per inner solve.
+    assert bound_qp.next_multiplier([(0.5, 2.0), (3.0, 0.0)], 1.0, 3.0, touch=1.5) == 1.5
+    # Inside the bracket of the pairs, else their midpoint.
+    assert bound_qp.next_multiplier([(1.6, 2.0), (3.0, 0.0)], 1.0, 3.0, touch=1.5) == pytest.approx(2.3)
+
+
 @pytest.mark.parametrize("upper", [math.inf, 0.7])
 def test_fused_natural_residual_is_that_of_report(upper):
     rng = np.random.default_rng(3)
