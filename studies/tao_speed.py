@@ -239,10 +239,11 @@ def report(rows, profile, folder):
              "`before` was measured at N = 512, p* = 0.5 only (each root-find solve costs minutes at 1024); GPCG "
              "under load control stalls after 1-2 inner solves at p* >= 0.5 (its projected search, as in the "
              "residual floors of tao_floors.py) and was not rerun at N = 1024 (`--solvers blmvm bqnls tron`). "
-             "The PK, BLMVM and BQNLS `after` rows are of the penalty 0.1, unrecycled memory and inner "
-             "tolerance 0.3 (`--solvers blmvm bqnls`); the TRON and GPCG `after` rows were not rerun "
-             "(commit 4ed21eb, contact stiffness to 0.1 % then; their inner tolerance is still 0.1), so their "
-             "`x PK` columns divide by the later PK run.", ""] + TRIED
+             "The `after` rows are of the penalty 0.1, unrecycled memory and inner tolerance 0.3 of the "
+             "quasi-Newton types, and of the inner-solve guard (an inner solve is done only after a step, and "
+             "the load error it may keep is capped at 1): PK, BLMVM and BQNLS from one run (`--solvers blmvm "
+             "bqnls`), TRON and GPCG from the next (`--solvers tron gpcg`, GPCG at N = 512 only), whose `x PK` "
+             "columns divide by the first run's PK.", ""] + TRIED
     if rows:
         lines += ["## Every solve", "", grid_table(rows), "", f"![time and pairs]({plot(rows, folder)})", ""]
     if profile:
