@@ -13,6 +13,9 @@ OPTIONS = [
     ("adhesion_work", 0.0, "work of adhesion w, pressure x length units"),
     ("adhesion_stress", 0.0, "Dugdale stress sigma0, pressure units (or -adhesion_range h0, then sigma0 = w / h0)"),
     ("adhesion_range", 0.0, "range of the law, length units: rho (exponential) or h0 (dugdale)"),
+    ("adhesion_curvature", True, "certify each result a local minimum to second order: the least curvature of the "
+                                 "energy on the feasible directions, kkt.min_curvature (an exponential law costs "
+                                 "LOBPCG about as many FFT pairs as the solve; false: not checked)"),
 ]
 
 

@@ -100,7 +100,7 @@ SolveSettings = make_dataclass(
     [("steps", tuple), ("load_option", str)]
     + [(name, type(default)) for name, default, _ in GENERAL_OPTIONS + SETTINGS_OPTIONS if name != "mode"]
     + [("tao_type", object), ("surface_file", str), ("boundary", str), ("hardness", float),
-       ("stress_depths", tuple), ("nu", float), ("adhesion", object)],
+       ("stress_depths", tuple), ("nu", float), ("adhesion", object), ("adhesion_curvature", bool)],
     frozen=True, namespace={
         # "displacement" for a prescribed mean gap, "load" otherwise.
         "control": property(lambda self: "displacement" if self.steps[0][0] == "gbar" else "load"),
@@ -175,7 +175,8 @@ def read_physics(reader):
         check_poisson(values["nu"])
     return {"boundary": values["boundary"], "hardness": hardness or None, "stress_depths": depths,
             "nu": values["nu"],
-            "adhesion": adhesive_options.read_law(values, {name for name in values if reader.hasName(name)})}
+            "adhesion": adhesive_options.read_law(values, {name for name in values if reader.hasName(name)}),
+            "adhesion_curvature": values["adhesion_curvature"]}
 
 
 def check_files(settings, comm):
@@ -398,6 +399,8 @@ def make_solver(settings, problem):
 
     with options_named():
         physics = problem if settings.adhesion is None else AdhesiveProblem(problem, settings.adhesion)
+        if settings.adhesion is not None:
+            physics.check_curvature = settings.adhesion_curvature
         return Solver(physics, settings.control, settings.tao_type, settings.kkt_rtol)
 
 

@@ -31,6 +31,7 @@ from ..errors import ParameterError
 from ..parallel import allmax, allmin, allsum
 from . import loops
 from .certificate import KKTReport, certified
+from .curvature import TOLERANCE as CURVATURE_TOLERANCE, least_curvature, longest_wave_stiffness
 from .result import Result, measure
 
 
@@ -60,6 +61,9 @@ class AdhesiveProblem:
         self.scaled_law = law.scaled(problem.height_scale, problem.pressure_scale)
         # The pressure scale of the residual: sqrt(m0^p) (2.52) of the non-adhesive problem, scaled units.
         self.residual_scale = math.sqrt(problem.m0p_scaled)
+        self.check_curvature = True  # the second-order half of the certificate (:mod:`.curvature`)
+        self.longest_wave_stiffness = None
+        self.least_mode = None  # the last eigenvector of least curvature: the next one's start along a path
         self.progress = None        # as ContactProblem's: the command line's progress line, Ctrl-C
         self.stop_requested = None
 
@@ -158,6 +162,9 @@ class AdhesiveProblem:
         total, = allsum(self.mpi, [g.sum()])
         kkt.load_error = abs(total / self.n - target)  # the prescribed mean gap's error, over sqrt(m0^h)
         converged, reason = certified(outcome.reason, kkt, rtol, "mean gap error", "S g")
+        if converged and self.check_curvature:
+            converged, reason = self._second_order(g, kkt, reason)
+        energy = self.energy(g, elastic) * self.pressure_scale * self.height_scale
         in_contact = (g == 0).astype(np.float64)
         measures = measure(self.elastic_problem, in_contact, g)
         pbar = -lam * self.pressure_scale
@@ -167,7 +174,21 @@ class AdhesiveProblem:
             gbar=gbar, gstar=target, separation=gbar, rms_gap_contact=0.0, kkt=kkt,
             iterations=outcome.iterations, operator_applications=self.operator.applications - applications,
             time_s=time.perf_counter() - started, reason=reason, converged=converged, solver=solver,
-            control="displacement", history=outcome.history)
+            control="displacement", history=outcome.history, energy=energy)
+
+    def _second_order(self, g, kkt, reason):
+        """``(converged, reason)`` with the least curvature in ``kkt``: a negative one is no local minimum."""
+        if self.longest_wave_stiffness is None:
+            self.longest_wave_stiffness = longest_wave_stiffness(self)
+        if self.least_mode is None:
+            self.least_mode = np.zeros_like(g)
+        kkt.min_curvature, how = least_curvature(self, g, self.longest_wave_stiffness, self.least_mode)
+        if kkt.min_curvature is None:
+            return True, f"{reason} (least curvature not determined: {how})"
+        if kkt.min_curvature < -CURVATURE_TOLERANCE:
+            return False, f"NOT_A_LOCAL_MINIMUM ({reason}, but the energy's least curvature is " \
+                          f"{kkt.min_curvature:.2g} s1 ({how}))"
+        return True, reason
 
     def fields(self, unknown, work, result):
         """This rank's rows of the total pressure S (g + h) + pbar (compressive positive) and the gap, in units."""

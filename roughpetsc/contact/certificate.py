@@ -24,6 +24,9 @@ class KKTReport:
     min_p : min(p) / pbar (primal feasibility, >= 0 at a solution).
     min_g : min(g) / sqrt(m0^h) over the nodes below the cap (dual feasibility, >= 0 at a solution).
     load_error : |mean(p) - pbar| / pbar under load control, None under displacement control.
+    min_curvature : adhesive contact: the least curvature of the energy on the feasible directions, over the
+        stiffness of the longest wavelength, or its lower bound 1 where that certifies (Dugdale)
+        (:mod:`~roughpetsc.contact.curvature`; > 0: a strict local minimum); None where not checked.
     """
 
     natural: float
@@ -31,6 +34,7 @@ class KKTReport:
     min_p: float
     min_g: float
     load_error: float = None
+    min_curvature: float = None
 
     def as_dict(self):
         return asdict(self)

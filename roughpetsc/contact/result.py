@@ -20,7 +20,8 @@ class Result:
 
     Pressures in pressure units, gaps in length units; ``pstar`` = pbar / sqrt(m0^p), ``gstar`` = gbar /
     sqrt(m0^h); ``A`` by node count (3.45), ``A_corrected`` with the perimeter correction; ``rms_gap_contact``
-    (3.50) over the elastic contact nodes; ``A_plastic`` the fraction of nodes at the cap.
+    (3.50) over the elastic contact nodes; ``A_plastic`` the fraction of nodes at the cap; ``energy`` the total
+    energy per unit area of an adhesive solution (pressure x length units, :mod:`~roughpetsc.contact.adhesive`).
     """
 
     pbar: float
@@ -41,6 +42,7 @@ class Result:
     control: str
     history: np.ndarray = field(default=None, repr=False)
     A_plastic: float = 0.0
+    energy: float = None
 
     def summary(self):
         """A JSON-ready dict (no fields, no history)."""

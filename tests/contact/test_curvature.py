@@ -1,0 +1,67 @@
+"""The second-order half of the adhesive certificate against a dense eigen-solve of the Hessian with numpy."""
+
+import numpy as np
+import pytest
+
+from roughpetsc.contact import AdhesiveProblem
+from roughpetsc.contact.curvature import TOLERANCE, least_curvature, longest_wave_stiffness
+from roughpetsc.contact.laws import Dugdale, Exponential
+from roughpetsc.contact.problem import ContactProblem
+from roughpetsc.solvers import Solver
+from roughpetsc.surface.generators import fractal
+from roughpetsc.surface.grid import Grid
+
+N, E_STAR = 24, 1.0
+
+
+def dense_least_curvature(law, gap):
+    """The least eigenvalue over pi E* / L of (S + diag phi''(g)) on zero-mean vectors of the free nodes, in the
+    units of the input, S = F^-1 pi E* |k| F as a dense matrix (L = 1)."""
+    k0 = np.fft.fftfreq(N, 1.0 / N)
+    k = np.hypot(*np.meshgrid(k0, k0, indexing="ij")).ravel()
+    fourier = np.fft.fft(np.fft.fft(np.eye(N * N).reshape(N * N, N, N), axis=1), axis=2).reshape(N * N, N * N)
+    stiffness = (fourier.conj().T @ (np.pi * E_STAR * k[:, None] * fourier)).real / (N * N)
+    free = gap.ravel() > 0
+    hessian = stiffness[np.ix_(free, free)] + np.diag(law.curvature(gap.ravel()[free]))
+    basis = np.linalg.qr(np.vstack([np.ones(free.sum()), np.eye(free.sum())[:-1]]).T)[0][:, 1:]  # zero mean
+    return np.linalg.eigvalsh(basis.T @ hessian @ basis)[0] / (np.pi * E_STAR)
+
+
+@pytest.fixture(scope="module")
+def problem():
+    grid = Grid(N, N, 1.0, 1.0)
+    contact = ContactProblem(grid, fractal(grid, 2, 6, 0.8, 1e-2, seed=3), E_STAR, fft_effort="FFTW_ESTIMATE")
+    yield contact
+    contact.destroy()
+
+
+@pytest.mark.parametrize("law, gbar", [(Exponential(5e-5, 1e-3), 7e-3), (Exponential(2e-5, 1e-4), 4e-3),
+                                       (Dugdale(5e-5, 5e-2), 7e-3)])
+def test_the_least_curvature_of_a_solution_is_that_of_the_dense_hessian(problem, law, gbar):
+    adhesive = AdhesiveProblem(problem, law)
+    solver = Solver(adhesive, "displacement", rtol=1e-10)
+    try:
+        result = solver.solve(gbar=gbar)
+        _, gap = solver.fields()
+        assert result.converged, result.reason
+        assert 0 < result.A < 1
+        exact = dense_least_curvature(law, gap)
+        if law.name == "dugdale":  # phi'' = 0 off the kink: the bound 1 <= the least curvature certifies
+            assert result.kkt.min_curvature == 1.0 <= exact
+        else:
+            assert result.kkt.min_curvature == pytest.approx(exact, abs=TOLERANCE)
+        assert result.energy == pytest.approx(adhesive.energy_of(gap) * problem.pressure_scale
+                                              * problem.height_scale, rel=1e-12)
+    finally:
+        solver.destroy()
+
+
+def test_a_negative_curvature_is_found(problem):
+    """A gap with many nodes deep in a strong exponential law's range: a saddle, not a minimum."""
+    law = Exponential(1e-4, 1e-4)
+    adhesive = AdhesiveProblem(problem, law)
+    gap = np.where(np.arange(N * N).reshape(N, N) % 3 == 0, 0.0, 5e-5) / problem.height_scale
+    value, how = least_curvature(adhesive, gap, longest_wave_stiffness(adhesive))
+    exact = dense_least_curvature(law, gap * problem.height_scale)
+    assert how.startswith("LOBPCG") and exact < -1
+    assert value == pytest.approx(exact, abs=TOLERANCE)
