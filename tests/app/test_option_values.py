@@ -200,3 +200,28 @@ def test_nothing_is_written_when_an_option_is_unused(tmp_path):
     assert not (tmp_path / "o.h5").exists()
     with pytest.raises(FileNotFoundError):
         h5py.File(tmp_path / "o.h5", "r")
+
+
+# --- bad values of every option: refused by name, none used silently ---------------------------------------------
+
+@pytest.mark.parametrize("args, named", [
+    (["-surface_seed", 99999999999], "-surface_seed"),     # was: seed 1215752191, silently
+    (["-surface_seed", 3000000000], "-surface_seed"),      # was: "must be non-negative, got -1294967296"
+    (["-surface_N", 4294967328], "-surface_N"),            # was: read as 32
+    (["-pk_refresh", 4294967346], "-pk_refresh"),          # a solver's integer (was: read as 50)
+    (["-mode", "stats", "-stats_ensemble", 4294967298], "-stats_ensemble"),
+])
+def test_an_integer_beyond_petsc_integers_is_refused(tmp_path, args, named):
+    surface = TINY[:6] if "stats" in args else TINY
+    out = run_cli(surface + args, cwd=tmp_path)
+    assert_one_clear_error(out, named, str(args[-1]), "beyond the integers")
+
+
+@pytest.mark.parametrize("args, named, kind", [
+    (["-E_star", "abc"], "-E_star", "as a number"),
+    (["-surface_N", 2.5], "-surface_N", "as an integer"),
+    (["-quiet", "maybe"], "-quiet", "as true or false"),
+])
+def test_an_unreadable_value_says_what_was_expected(tmp_path, args, named, kind):
+    out = run_cli(TINY + args, cwd=tmp_path)
+    assert_one_clear_error(out, named, f"'{args[-1]}' {kind}")
