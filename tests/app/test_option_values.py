@@ -205,6 +205,28 @@ def test_nothing_is_written_when_an_option_is_unused(tmp_path):
 # --- bad values of every option: refused by name, none used silently ---------------------------------------------
 
 @pytest.mark.parametrize("args, named", [
+    (["-surface_N0", -1], ["-surface_N0", "-1"]),                  # was: named -surface_N
+    (["-surface_N0", 1], ["-surface_N0", "at least 2 rows"]),       # was: named -surface_type
+    (["-surface_ks", "nan"], ["-surface_ks", "nan"]),               # was: named -surface_kl
+    (["-surface_ks", 0], ["-surface_ks", "positive"]),
+    (["-surface_ks", 1], ["-surface_kl/-surface_ks"]),              # k_s below k_l: was named -surface_kl alone
+    (["-surface_m2", "inf"], ["-surface_m2", "finite"]),            # was: named -surface_type, "NaN or Inf"
+    (["-surface_seed", -1], ["-surface_seed", "non-negative"]),     # was: a traceback, exit 1
+    (["-surface_type", "wave", "-surface_amplitude", "1e400"], ["-surface_amplitude", "finite"]),
+    (["-surface_type", "bisinusoid", "-surface_amplitude", "inf"], ["-surface_amplitude", "finite"]),
+    (["-surface_type", "sphere", "-surface_radius", "inf"], ["-surface_radius", "finite"]),  # was: "flat"
+])
+def test_a_value_out_of_range_is_refused_by_its_own_name(tmp_path, args, named):
+    if "-surface_type" in args:  # a periodic wave or sphere takes no fractal cut-offs
+        args = ["-surface_N", 32, "-fft_effort", "FFTW_ESTIMATE"] + args
+    else:
+        args = TINY + args
+    out = run_cli(args + ["-json", "s.json"], cwd=tmp_path)
+    message = assert_one_clear_error(out, *named)
+    assert out.stdout == "" and not list(tmp_path.iterdir()), message
+
+
+@pytest.mark.parametrize("args, named", [
     (["-surface_seed", 99999999999], "-surface_seed"),     # was: seed 1215752191, silently
     (["-surface_seed", 3000000000], "-surface_seed"),      # was: "must be non-negative, got -1294967296"
     (["-surface_N", 4294967328], "-surface_N"),            # was: read as 32
