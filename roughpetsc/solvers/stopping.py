@@ -69,9 +69,9 @@ def check_int_range(options, name, value):
 def max_seconds(prefix=None):
     """``-solve_max_time`` under ``prefix``: seconds after which a solve stops (0: no limit)."""
     seconds = read_option(PETSc.Options(prefix), "Real", "solve_max_time", 0.0)
-    if not seconds >= 0:
-        raise UserError(f"{option_name('solve_max_time', prefix)} must be a non-negative number of seconds, "
-                        f"got {seconds}")
+    if not (seconds >= 0 and np.isfinite(seconds)):
+        raise UserError(f"{option_name('solve_max_time', prefix)} must be a non-negative, finite number of seconds "
+                        f"(0: no limit), got {seconds}")
     return seconds
 
 

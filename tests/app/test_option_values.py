@@ -215,6 +215,8 @@ def test_nothing_is_written_when_an_option_is_unused(tmp_path):
     (["-surface_type", "wave", "-surface_amplitude", "1e400"], ["-surface_amplitude", "finite"]),
     (["-surface_type", "bisinusoid", "-surface_amplitude", "inf"], ["-surface_amplitude", "finite"]),
     (["-surface_type", "sphere", "-surface_radius", "inf"], ["-surface_radius", "finite"]),  # was: "flat"
+    (["-tao_type", "blmvm", "-bound_al_penalty", "inf"], ["-bound_al_penalty", "finite"]),   # was: error code 83
+    (["-solve_max_time", "inf"], ["-solve_max_time", "finite"]),    # was: accepted
 ])
 def test_a_value_out_of_range_is_refused_by_its_own_name(tmp_path, args, named):
     if "-surface_type" in args:  # a periodic wave or sphere takes no fractal cut-offs
