@@ -249,3 +249,11 @@ def test_an_integer_beyond_petsc_integers_is_refused(tmp_path, args, named):
 def test_an_unreadable_value_says_what_was_expected(tmp_path, args, named, kind):
     out = run_cli(TINY + args, cwd=tmp_path)
     assert_one_clear_error(out, named, f"'{args[-1]}' {kind}")
+
+
+@pytest.mark.parametrize("models", ["gw,,persson", "gw,"])
+def test_an_empty_item_of_ensemble_models_is_refused(tmp_path, models):
+    out = run_cli(TINY + ["-mode", "ensemble", "-ensemble_size", 1, "-ensemble_loads", 0.5, "-ensemble_models",
+                          models, "-output", "e.h5"], cwd=tmp_path)  # was: gw and persson, silently
+    assert_one_clear_error(out, "-ensemble_models", "empty item")
+    assert not list(tmp_path.iterdir())
