@@ -257,3 +257,24 @@ def test_an_empty_item_of_ensemble_models_is_refused(tmp_path, models):
                           models, "-output", "e.h5"], cwd=tmp_path)  # was: gw and persson, silently
     assert_one_clear_error(out, "-ensemble_models", "empty item")
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("content", [b"\x00\xff garbage", b'{"grid": [1, 2], "steps": []}'])
+def test_a_wisdom_file_of_something_else_is_refused_not_replaced(tmp_path, monkeypatch, content):
+    monkeypatch.delenv("ROUGHPETSC_FFT_WISDOM", raising=False)  # the file of -fft_wisdom is used
+    monkeypatch.delenv("ROUGHPETSC_FFT_EFFORT", raising=False)
+    (tmp_path / "w.json").write_bytes(content)
+    out = run_cli(TINY[:6] + ["-fft_effort", "FFTW_MEASURE", "-fft_wisdom", "w.json", "-json", "s.json"],
+                  cwd=tmp_path)
+    assert_one_clear_error(out, "-fft_wisdom", "w.json", "not an FFTW wisdom file")
+    assert (tmp_path / "w.json").read_bytes() == content  # was: replaced by the wisdom of the run
+    assert not (tmp_path / "s.json").exists()
+
+
+def test_an_empty_wisdom_file_is_filled(tmp_path, monkeypatch):
+    monkeypatch.delenv("ROUGHPETSC_FFT_WISDOM", raising=False)
+    monkeypatch.delenv("ROUGHPETSC_FFT_EFFORT", raising=False)
+    (tmp_path / "w.json").write_bytes(b"")
+    out = run_cli(TINY[:6] + ["-fft_effort", "FFTW_MEASURE", "-fft_wisdom", "w.json", "-quiet"], cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert (tmp_path / "w.json").stat().st_size > 0
