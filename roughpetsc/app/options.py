@@ -7,6 +7,7 @@ from petsc4py import PETSc
 
 from ..errors import UserError
 from ..solvers.options import FINALIZE_OPTIONS, petsc_library, read_late, unused_options
+from ..solvers.stopping import KIND_WORDS, check_int_range
 from ..contact.loads import LIST_FILE_PREFIX, parse_reals
 
 # Prefixes of options that PETSc objects or PETSc itself read.
@@ -26,17 +27,20 @@ class Reader:
     def __init__(self, database=None):
         self.database = database or PETSc.Options()
 
-    def _get(self, getter, name, default):
+    def _get(self, getter, name, default, kind=None):
         try:
             return getter(name, default)
         except PETSc.Error:
-            raise UserError(f"-{name}: cannot read the value '{self.database.getString(name, '')}'") from None
+            what = f" as {KIND_WORDS[kind]}" if kind else ""
+            raise UserError(f"-{name}: cannot read the value '{self.database.getString(name, '')}'{what}") from None
 
     def getReal(self, name, default):
-        return self._get(self.database.getReal, name, default)
+        return self._get(self.database.getReal, name, default, "Real")
 
     def getInt(self, name, default):
-        return self._get(self.database.getInt, name, default)
+        value = self._get(self.database.getInt, name, default, "Int")
+        check_int_range(self.database, name, value)
+        return value
 
     def getString(self, name, default):
         """The value of ``-name`` as given (any length), or ``default`` if the option is absent."""
@@ -44,7 +48,7 @@ class Reader:
         return whole_string(name, text, self.database.prefix) if self.database.hasName(name) else text
 
     def getBool(self, name, default):
-        return self._get(self.database.getBool, name, default)
+        return self._get(self.database.getBool, name, default, "Bool")
 
     def hasName(self, name):
         return self.database.hasName(name)

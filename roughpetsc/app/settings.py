@@ -36,6 +36,7 @@ ENSEMBLE_SEED = ("ensemble_seed", 1, "master seed of an ensemble; surface i gets
 
 # The option that sets each parameter the library names in a ParameterError (roughpetsc.errors), in every mode.
 PARAMETER_OPTIONS = {**{keyword: option for option, keyword in surface_options.FRACTAL_KEYWORDS.items()},
+                     "cut_offs": "surface_kl/-surface_ks",
                      "n1": "surface_N", "n0": "surface_N0/-surface_N", "length": "surface_L",
                      "kind": "surface_type", "heights": "surface_type", "path": "surface_file",
                      "amplitude": "surface_amplitude", "wavelength": "surface_wavelength", "radius": "surface_radius",

@@ -1,6 +1,6 @@
 """The surface options of the command line (``-surface_*``): their table, defaults and the surface they name."""
 
-from ..errors import ParameterError
+from ..errors import ParameterError, UserError
 from ..surface.files import level, load, validate
 from ..surface.generators import DEFAULT_GENERATOR, bisinusoid, fractal, hertz_sphere, wave
 from ..surface.grid import square_grid
@@ -68,6 +68,9 @@ def parameters(opts):
 def grid_from_options(opts):
     """The :class:`Grid` named by ``-surface_N``, ``-surface_N0`` and ``-surface_L``."""
     given = option_values(opts, ("surface_N", "surface_N0", "surface_L"))
+    if given["surface_N0"] < 0 or given["surface_N0"] == 1:
+        raise UserError(f"-surface_N0 must be 0 (as many rows as -surface_N) or at least 2 rows, "
+                        f"got {given['surface_N0']}")
     return square_grid(given["surface_N"], given["surface_N0"], given["surface_L"])
 
 
@@ -97,6 +100,8 @@ def from_options(opts, seed=None, notes=None):
         raise ParameterError("kind", f"unknown surface type '{kind}' (fractal, bisinusoid, wave, sphere)")
     given = option_values(opts, TYPE_OPTIONS[kind])
     if kind == "fractal":
+        if given["surface_seed"] < 0:
+            raise UserError(f"-surface_seed must be a non-negative integer, got {given['surface_seed']}")
         keywords = {FRACTAL_KEYWORDS[name]: value for name, value in given.items()}
         heights = fractal(grid, **dict(keywords, seed=keywords["seed"] if seed is None else seed))
     elif kind == "sphere":

@@ -61,7 +61,10 @@ def parse_models(text):
         return MODEL_NAMES
     if text in ("none", ""):
         return ()
-    names = tuple(item.strip() for item in text.split(",") if item.strip())
+    names = tuple(item.strip() for item in text.split(","))
+    if not all(names):  # 'gw,,persson' or a trailing comma: a name was left out
+        raise UserError(f"-ensemble_models: empty item in '{text}' (all, none, or a comma list of "
+                        f"{', '.join(MODEL_NAMES)})")
     for name in names:
         if name not in MODEL_NAMES:
             raise UserError(f"-ensemble_models: unknown model '{name}' (all, none, or a list of "

@@ -65,9 +65,11 @@ def wisdom_path(option_value):
 
 
 def check_wisdom_path(option_value, option):
-    """Refuse, naming ``-option``, a wisdom file given in a folder that does not exist, or a folder.
+    """Refuse, naming ``-option``, a wisdom file given in a folder that does not exist, a folder, or a file that
+    holds something else than wisdom.
 
-    Such a path would otherwise be skipped silently, and every run would measure its plans again.
+    Such a path would otherwise be skipped silently, and every run would measure its plans again; a file of
+    something else would be replaced by the wisdom. An empty file is a cache yet to be filled.
     """
     value = (option_value or "").strip()
     if not value or value.lower() == "none":
@@ -77,6 +79,17 @@ def check_wisdom_path(option_value, option):
     folder = os.path.dirname(os.path.abspath(value))
     if not os.path.isdir(folder):
         raise UserError(f"-{option} {value}: the folder {folder} does not exist")
+    if os.path.isfile(value) and os.path.getsize(value) > 0:
+        try:
+            with open(value) as f:
+                items = json.loads(f.read())
+            if not (isinstance(items, list) and all(isinstance(item, str) for item in items)):
+                raise ValueError("not a list of strings")
+            for item in items:
+                base64.b64decode(item, validate=True)
+        except (OSError, ValueError):
+            raise UserError(f"-{option} {value}: not an FFTW wisdom file of roughpetsc; give another file name "
+                            "(or none)") from None
 
 
 def decode_wisdom(text):

@@ -418,8 +418,9 @@ class BoundQP(Backend):
         if preconditioner not in BOUND_PRECONDITIONERS:
             raise UserError(f"{option_name('bound_pc', prefix)}: unknown preconditioner '{preconditioner}' "
                             f"(one of {', '.join(BOUND_PRECONDITIONERS)})")
-        if not self.penalty_factor > 0:
-            raise UserError(f"{option_name('bound_al_penalty', prefix)} must be positive, got {self.penalty_factor}")
+        if not (self.penalty_factor > 0 and np.isfinite(self.penalty_factor)):
+            raise UserError(f"{option_name('bound_al_penalty', prefix)} must be positive and finite, "
+                            f"got {self.penalty_factor}")
         if not 0 <= self.eta < 1:
             raise UserError(f"{option_name('bound_al_eta', prefix)} must be in [0, 1), got {self.eta}")
         if self.max_outer < 1:

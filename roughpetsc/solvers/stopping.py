@@ -42,18 +42,36 @@ def read_option(options, kind, name, default):
     PETSc's own message ("Input string abc has no numeric value") names neither the option nor its prefix.
     """
     try:
-        return getattr(options, "get" + kind)(name, default)
+        value = getattr(options, "get" + kind)(name, default)
     except PETSc.Error:
         raise UserError(f"{option_name(name, options.prefix)}: cannot read the value '{options.getString(name, '')}' "
                         f"as {KIND_WORDS[kind]}") from None
+    if kind == "Int":
+        check_int_range(options, name, value)
+    return value
+
+
+def check_int_range(options, name, value):
+    """Refuse an integer ``-name`` beyond PETSc's integers: PETSc reads 3000000000 as -1294967296, silently."""
+    if not options.hasName(name):
+        return
+    text = options.getString(name, "").strip()
+    try:
+        given = int(text)
+    except ValueError:
+        return
+    if given != value:
+        limits = np.iinfo(PETSc.IntType)
+        raise UserError(f"{option_name(name, options.prefix)}: the value '{text}' is beyond the integers PETSc "
+                        f"reads ({limits.min} to {limits.max})")
 
 
 def max_seconds(prefix=None):
     """``-solve_max_time`` under ``prefix``: seconds after which a solve stops (0: no limit)."""
     seconds = read_option(PETSc.Options(prefix), "Real", "solve_max_time", 0.0)
-    if not seconds >= 0:
-        raise UserError(f"{option_name('solve_max_time', prefix)} must be a non-negative number of seconds, "
-                        f"got {seconds}")
+    if not (seconds >= 0 and np.isfinite(seconds)):
+        raise UserError(f"{option_name('solve_max_time', prefix)} must be a non-negative, finite number of seconds "
+                        f"(0: no limit), got {seconds}")
     return seconds
 
 

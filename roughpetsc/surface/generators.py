@@ -31,10 +31,14 @@ def check_fractal_parameters(grid, k_l, k_s, hurst, m2):
     nyquist = min(grid.n0 / grid.l0, grid.n1 / grid.l1) / 2.0
     if not 0.0 < hurst < 1.0:
         raise ParameterError("hurst", f"the Hurst exponent must lie in (0, 1), got {hurst}")
-    if not m2 > 0.0:
-        raise ParameterError("m2", f"the mean square slope m2 must be positive, got {m2}")
+    if not (m2 > 0.0 and np.isfinite(m2)):
+        raise ParameterError("m2", f"the mean square slope m2 must be positive and finite, got {m2}")
+    if not (k_s > 0.0 and np.isfinite(k_s)):
+        raise ParameterError("k_s", f"the cut-off k_s must be a positive, finite wavenumber, got {k_s}")
     if not 0.0 < k_l < k_s:
-        raise ParameterError("k_l", f"need 0 < k_l < k_s for the cut-off wavenumbers, got k_l={k_l}, k_s={k_s}")
+        # Cut-offs in the wrong order: either may be the one meant otherwise.
+        parameter = "cut_offs" if 0.0 < k_l < np.inf else "k_l"
+        raise ParameterError(parameter, f"need 0 < k_l < k_s for the cut-off wavenumbers, got k_l={k_l}, k_s={k_s}")
     if k_s > nyquist:
         raise ParameterError("k_s", f"the cut-off k_s={k_s} exceeds the Nyquist wavenumber {nyquist} of the grid")
     if k_l < 1.0 / max(grid.l0, grid.l1):
@@ -74,9 +78,9 @@ def fractal(grid, k_l, k_s, hurst, m2, seed, generator=DEFAULT_GENERATOR):
 
 
 def check_waviness(amplitude, *wavelengths):
-    """Raise :class:`ParameterError` unless the amplitude and the wavelengths (length units) are positive."""
-    if not amplitude > 0:
-        raise ParameterError("amplitude", f"the amplitude must be positive, got {amplitude}")
+    """Raise :class:`ParameterError` unless the amplitude (finite) and the wavelengths (length units) are positive."""
+    if not (amplitude > 0 and np.isfinite(amplitude)):
+        raise ParameterError("amplitude", f"the amplitude must be positive and finite, got {amplitude}")
     if not all(wavelength > 0 for wavelength in wavelengths):
         raise ParameterError("wavelength", f"the wavelength must be positive, got {', '.join(map(str, wavelengths))}")
 
@@ -112,8 +116,8 @@ def wave(grid, amplitude, wavelength):
 
 def hertz_sphere(grid, radius):
     """A paraboloid cap ``-r^2 / (2 R)`` centred in the cell, zero mean (a sphere in a large cell)."""
-    if not radius > 0:
-        raise ParameterError("radius", f"the radius of the sphere must be positive, got {radius}")
+    if not (radius > 0 and np.isfinite(radius)):
+        raise ParameterError("radius", f"the radius of the sphere must be positive and finite, got {radius}")
     y, x = grid.coordinates()
     r2 = (y - grid.l0 / 2) ** 2 + (x - grid.l1 / 2) ** 2
     heights = -r2 / (2.0 * radius)

@@ -200,3 +200,81 @@ def test_nothing_is_written_when_an_option_is_unused(tmp_path):
     assert not (tmp_path / "o.h5").exists()
     with pytest.raises(FileNotFoundError):
         h5py.File(tmp_path / "o.h5", "r")
+
+
+# --- bad values of every option: refused by name, none used silently ---------------------------------------------
+
+@pytest.mark.parametrize("args, named", [
+    (["-surface_N0", -1], ["-surface_N0", "-1"]),                  # was: named -surface_N
+    (["-surface_N0", 1], ["-surface_N0", "at least 2 rows"]),       # was: named -surface_type
+    (["-surface_ks", "nan"], ["-surface_ks", "nan"]),               # was: named -surface_kl
+    (["-surface_ks", 0], ["-surface_ks", "positive"]),
+    (["-surface_ks", 1], ["-surface_kl/-surface_ks"]),              # k_s below k_l: was named -surface_kl alone
+    (["-surface_m2", "inf"], ["-surface_m2", "finite"]),            # was: named -surface_type, "NaN or Inf"
+    (["-surface_seed", -1], ["-surface_seed", "non-negative"]),     # was: a traceback, exit 1
+    (["-surface_type", "wave", "-surface_amplitude", "1e400"], ["-surface_amplitude", "finite"]),
+    (["-surface_type", "bisinusoid", "-surface_amplitude", "inf"], ["-surface_amplitude", "finite"]),
+    (["-surface_type", "sphere", "-surface_radius", "inf"], ["-surface_radius", "finite"]),  # was: "flat"
+    (["-tao_type", "blmvm", "-bound_al_penalty", "inf"], ["-bound_al_penalty", "finite"]),   # was: error code 83
+    (["-solve_max_time", "inf"], ["-solve_max_time", "finite"]),    # was: accepted
+])
+def test_a_value_out_of_range_is_refused_by_its_own_name(tmp_path, args, named):
+    if "-surface_type" in args:  # a periodic wave or sphere takes no fractal cut-offs
+        args = ["-surface_N", 32, "-fft_effort", "FFTW_ESTIMATE"] + args
+    else:
+        args = TINY + args
+    out = run_cli(args + ["-json", "s.json"], cwd=tmp_path)
+    message = assert_one_clear_error(out, *named)
+    assert out.stdout == "" and not list(tmp_path.iterdir()), message
+
+
+@pytest.mark.parametrize("args, named", [
+    (["-surface_seed", 99999999999], "-surface_seed"),     # was: seed 1215752191, silently
+    (["-surface_seed", 3000000000], "-surface_seed"),      # was: "must be non-negative, got -1294967296"
+    (["-surface_N", 4294967328], "-surface_N"),            # was: read as 32
+    (["-pk_refresh", 4294967346], "-pk_refresh"),          # a solver's integer (was: read as 50)
+    (["-mode", "stats", "-stats_ensemble", 4294967298], "-stats_ensemble"),
+])
+def test_an_integer_beyond_petsc_integers_is_refused(tmp_path, args, named):
+    surface = TINY[:6] if "stats" in args else TINY
+    out = run_cli(surface + args, cwd=tmp_path)
+    assert_one_clear_error(out, named, str(args[-1]), "beyond the integers")
+
+
+@pytest.mark.parametrize("args, named, kind", [
+    (["-E_star", "abc"], "-E_star", "as a number"),
+    (["-surface_N", 2.5], "-surface_N", "as an integer"),
+    (["-quiet", "maybe"], "-quiet", "as true or false"),
+])
+def test_an_unreadable_value_says_what_was_expected(tmp_path, args, named, kind):
+    out = run_cli(TINY + args, cwd=tmp_path)
+    assert_one_clear_error(out, named, f"'{args[-1]}' {kind}")
+
+
+@pytest.mark.parametrize("models", ["gw,,persson", "gw,"])
+def test_an_empty_item_of_ensemble_models_is_refused(tmp_path, models):
+    out = run_cli(TINY + ["-mode", "ensemble", "-ensemble_size", 1, "-ensemble_loads", 0.5, "-ensemble_models",
+                          models, "-output", "e.h5"], cwd=tmp_path)  # was: gw and persson, silently
+    assert_one_clear_error(out, "-ensemble_models", "empty item")
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("content", [b"\x00\xff garbage", b'{"grid": [1, 2], "steps": []}'])
+def test_a_wisdom_file_of_something_else_is_refused_not_replaced(tmp_path, monkeypatch, content):
+    monkeypatch.delenv("ROUGHPETSC_FFT_WISDOM", raising=False)  # the file of -fft_wisdom is used
+    monkeypatch.delenv("ROUGHPETSC_FFT_EFFORT", raising=False)
+    (tmp_path / "w.json").write_bytes(content)
+    out = run_cli(TINY[:6] + ["-fft_effort", "FFTW_MEASURE", "-fft_wisdom", "w.json", "-json", "s.json"],
+                  cwd=tmp_path)
+    assert_one_clear_error(out, "-fft_wisdom", "w.json", "not an FFTW wisdom file")
+    assert (tmp_path / "w.json").read_bytes() == content  # was: replaced by the wisdom of the run
+    assert not (tmp_path / "s.json").exists()
+
+
+def test_an_empty_wisdom_file_is_filled(tmp_path, monkeypatch):
+    monkeypatch.delenv("ROUGHPETSC_FFT_WISDOM", raising=False)
+    monkeypatch.delenv("ROUGHPETSC_FFT_EFFORT", raising=False)
+    (tmp_path / "w.json").write_bytes(b"")
+    out = run_cli(TINY[:6] + ["-fft_effort", "FFTW_MEASURE", "-fft_wisdom", "w.json", "-quiet"], cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert (tmp_path / "w.json").stat().st_size > 0
