@@ -38,8 +38,11 @@ def presets(folder):
 def fractal_group(number):
     """The fractal surface of group ``number`` (``options/groupNN.opts``), defaults filled in.
 
-    ``{n, length, k_l, k_s, hurst, m2, generator}``: nodes per side, cell length along x (length units) and
-    the keywords of :func:`roughpetsc.surfaces.fractal` (k in cycles/length).
+    Returns
+    -------
+    dict
+        ``n`` (nodes per side), ``length`` (cell length along x [length]) and the keywords ``k_l``, ``k_s``
+        [cycles/length], ``hurst``, ``m2``, ``generator`` of :func:`roughpetsc.surfaces.fractal`.
     """
     from .surface_options import FRACTAL_KEYWORDS, SURFACE_OPTIONS
 

@@ -84,12 +84,22 @@ def _complete_curves(pstar, alpha_p, alpha_h, name, notes):
 def compute_models(pstar, alpha_h, alpha_p, surface, E_star, names, statistics):
     """The statistical models at the steps' p* with the ensemble's mean bandwidths, and kappa = dA*/dp*.
 
-    ``pstar``: the steps' increasing p* = pbar / sqrt(m0^p); ``alpha_h``, ``alpha_p``: mean bandwidths (2.16),
-    (2.54); ``surface``: the fractal ``kl, ks, H, m2`` (Persson's gap, App. E); ``E_star``: E* (1.6); ``names``:
-    of :data:`MODEL_NAMES`; ``statistics``: :func:`step_statistics` (kappa of the BEM means).
+    Parameters
+    ----------
+    pstar : ndarray (m,)
+        The steps' p* = pbar / sqrt(m0^p) [-], increasing.
+    alpha_h, alpha_p : float
+        The ensemble's mean bandwidths (2.16), (2.54) [-].
+    surface, E_star : dict, float
+        The fractal ``kl, ks, H, m2`` (Persson's gap, App. E) and the composite modulus E* (1.6) [pressure].
+    names, statistics : iterable of str, dict
+        The models to compute (:data:`MODEL_NAMES`); :func:`step_statistics` (kappa of the BEM means).
 
-    Returns ``{"pstar", "alpha_h", "alpha_p", "early_pmax", "early": {model: {"A", "dstar"}}, "complete":
-    {model: {"A", "gstar"}}, "persson": {"A", "gstar"}, "kappa": {curve: (m,)}, "notes": {curve: why NaN}}``.
+    Returns
+    -------
+    dict
+        ``{"pstar", "alpha_h", "alpha_p", "early_pmax", "early": {model: {"A", "dstar"}}, "complete": {model: {"A",
+        "gstar"}}, "persson": {"A", "gstar"}, "kappa": {curve: (m,)}, "notes": {curve: why NaN}}``.
     """
     from .. import models
 

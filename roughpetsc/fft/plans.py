@@ -103,10 +103,18 @@ def encode_wisdom(wisdom):
 
 @contextmanager
 def remembered_plans(comm, path, effort):
-    """Plans made inside the block come from (and go to) the wisdom file ``path`` (None: no file).
+    """Plans made inside the block come from (and go to) the wisdom file ``path``.
 
     Every rank imports rank 0's wisdom; afterwards rank 0 merges every rank's and writes it back atomically
     if planning added to it (a cache that cannot be written is skipped). Nothing happens for ESTIMATE plans.
+
+    Parameters
+    ----------
+    comm : mpi4py.MPI.Comm
+    path : str or None
+        The wisdom file; None: no file.
+    effort : str
+        The planner flag the block will use (after :func:`planner_effort`).
     """
     import pyfftw
 

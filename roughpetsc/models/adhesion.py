@@ -238,10 +238,21 @@ class AdhesiveCrack:
         return np.where(ok, self.b_of_q(q), np.nan), np.where(ok, self.m_of_q(q), np.nan)
 
     def state(self, p, p_min=None):
-        """Crack radius and m ``(b, m)`` at p* after a load history whose smallest p* was ``p_min`` (Figs. 6.2-6.3).
+        """Crack radius and m after a load history (Figs. 6.2-6.3).
 
-        Loading: stable branch down to B, then closure (p_B <= sigma0*) or the full-adhesion branch (6.36) down
-        to E. Unloading after ``p_min < p_B``: closed below E (6.38), full adhesion from E to F (6.39), jump to G.
+        Parameters
+        ----------
+        p : array_like
+            Current p* [-].
+        p_min : array_like, optional
+            Smallest p* reached so far [-] (default ``p``: loading). Loading: stable branch down to B, then closure
+            (p_B <= sigma0*) or full adhesion (6.36) down to E. Unloading after ``p_min < p_B``: closed below E
+            (6.38), full adhesion from E to F (6.39), jump to G.
+
+        Returns
+        -------
+        b, m : ndarray
+            Crack radius and m [-].
         """
         p = np.atleast_1d(np.asarray(p, float))
         pm = p if p_min is None else np.minimum(np.atleast_1d(np.asarray(p_min, float)), p)
@@ -283,12 +294,21 @@ CRACK_LAWS = ("maugis-dugdale", "jkr")
 
 
 class AdhesiveGW:
-    """Adhesive adapted GW model of nearly complete contact, Eqs. (6.40)-(6.54).
+    """Adhesive adapted GW model of nearly complete contact, Eqs. (6.40)-(6.54), in p* = pbar/sqrt(m0^p),
+    g* = gbar/sqrt(m0^h).
 
-    Moments m0h..m6h of the surface [length^2], [-], [1/length^2], [1/length^4]; the surface energy is
-    w = sigma0 z0 ((6.56)), z0 [length]. ``n_elements``: Gauss-Legendre elements per interval between the
-    crack's breakpoints and on the tail. ``crack_law``: :class:`AdhesiveCrack` at the sigma0* of (6.6), or
-    :class:`JKRCrack` ("JKR limit" of Figs. 6.9-6.10). Results: p* = pbar/sqrt(m0^p), g* = gbar/sqrt(m0^h).
+    Parameters
+    ----------
+    m0h, m2h, m4h, m6h : float
+        Spectral moments of the surface [length^2], [-], [1/length^2], [1/length^4].
+    sigma0_over_E : float
+        Dugdale stress over E* [-].
+    z0 : float
+        Range of adhesion [length]; the surface energy is w = sigma0 z0 (the convention of (6.56)).
+    n_elements : int
+        Gauss-Legendre elements per interval between the crack's breakpoints and on the tail.
+    crack_law : {"maugis-dugdale", "jkr"}
+        :class:`AdhesiveCrack` at the sigma0* of (6.6), or :class:`JKRCrack` ("JKR limit" of Figs. 6.9-6.10).
     """
 
     XI_CUT = 12.0   # the summit-height density (2.42) is below exp(-C1 xi^2) <= exp(-72) beyond xi* = 12

@@ -25,10 +25,23 @@ def _ciavarella(p, alpha_h, n_elements=12):
 
 
 def complete(name, pstar, alpha_p, alpha_h, elements=None):
-    """Contact ratio A* and mean gap g* of a nearly-complete-contact model at p* >= 0 (A* < 0 at small p* possible).
+    """Contact ratio and mean gap of a nearly-complete-contact model.
 
-    ``name``: adapted GW (5.37)-(5.38), Nayak-Bush (5.41)-(5.42), Greenwood (5.45)-(5.46), Ciavarella asymptotic
-    (5.53)-(5.54) (no alpha_p). alpha_p (2.54) and alpha_h (2.16) > 3/2.
+    Parameters
+    ----------
+    name : {"gw", "nayak_bush", "greenwood", "ciavarella"}
+        Adapted GW (5.37)-(5.38), Nayak-Bush (5.41)-(5.42), Greenwood (5.45)-(5.46), Ciavarella (5.53)-(5.54).
+    pstar : array_like
+        p* = pbar / sqrt(m0^p) >= 0 [-].
+    alpha_p, alpha_h : float
+        Bandwidths of the pressure surface (2.54) and of the surface (2.16), > 3/2 (no alpha_p in "ciavarella").
+    elements : tuple of int, optional
+        Gauss-Legendre elements per dimension.
+
+    Returns
+    -------
+    A, gstar : ndarray
+        A* [-] (may be < 0 at small p*, outside the model's range) and g* = gbar / sqrt(m0^h) [-].
     """
     p = np.atleast_1d(np.asarray(pstar, dtype=float))
     if not np.all(np.isfinite(p)):

@@ -38,10 +38,20 @@ def correction(pstar, b, c, d):
 
 
 def curvefit_reference(pstar, alpha_p, model=CURVEFIT_MODEL):
-    """I(p*) of (8.2): A* of a nearly-complete-contact model at p* >= 0, alpha^p (2.54) > 3/2.
+    """I(p*) of (8.2): the contact ratio of a nearly-complete-contact model.
 
-    ``model``: a name of :data:`~roughpetsc.models.complete.COMPLETE_MODELS` ("gw" (5.37), "nayak_bush" (5.41),
-    "greenwood" (5.45), "ciavarella" (5.54)) or a function of p* returning A*.
+    Parameters
+    ----------
+    pstar, alpha_p : array_like, float
+        p* = pbar / sqrt(m0^p) >= 0 [-] and the bandwidth of the pressure surface (2.54), > 3/2.
+    model : str or callable
+        A name of :data:`~roughpetsc.models.complete.COMPLETE_MODELS` ("gw" (5.37), "nayak_bush" (5.41),
+        "greenwood" (5.45), "ciavarella" (5.54)) or a function of p* returning A*.
+
+    Returns
+    -------
+    ndarray
+        I(p*) = A* of the model [-].
     """
     p = np.atleast_1d(np.asarray(pstar, dtype=float))
     if callable(model):
@@ -52,14 +62,40 @@ def curvefit_reference(pstar, alpha_p, model=CURVEFIT_MODEL):
 
 
 def curvefit_area(pstar, alpha_p, b, c, d, model=CURVEFIT_MODEL):
-    """Curve-fit contact ratio A*(p*), Eq. (8.2), with b, c, d of (8.3) (Table 8.4), I of :func:`curvefit_reference`."""
+    """Curve-fit contact ratio A*(p*), Eq. (8.2).
+
+    Parameters
+    ----------
+    pstar, alpha_p : array_like, float
+        As in :func:`curvefit_reference`.
+    b, c, d : float
+        Parameters of (8.3) (Table 8.4), a = -c.
+    model : str or callable
+        I(p*) (:func:`curvefit_reference`); the default, (5.37) with (2.42), is the one of Table 8.4.
+
+    Returns
+    -------
+    ndarray
+        A* [-].
+    """
     p = np.atleast_1d(np.asarray(pstar, dtype=float))
     I = curvefit_reference(p, alpha_p, model)
     return np.where(p <= P_SPLIT, I * correction(p, b, c, d), I)
 
 
 def curvefit_slope_at_zero(alpha_p, b, c, d, model=CURVEFIT_MODEL):
-    """dA*/dp* of the curve fit (8.2)-(8.3) at p* = 0: I(0) c (d - b) (section 8.5: close to :data:`BGT_SLOPE`)."""
+    """dA*/dp* of the curve fit (8.2)-(8.3) at p* = 0: I(0) c (d - b) (section 8.5: close to :data:`BGT_SLOPE`).
+
+    Parameters
+    ----------
+    alpha_p, b, c, d, model :
+        As in :func:`curvefit_area`.
+
+    Returns
+    -------
+    float
+        The slope [-].
+    """
     return float(curvefit_reference(np.zeros(1), alpha_p, model)[0]) * c * (d - b)
 
 
@@ -92,9 +128,21 @@ def _d_for_slope(b, slope, I0):
 def fit_curvefit(pstar, area, alpha_p, guess=(-1.9, -0.05), slope=None, model=CURVEFIT_MODEL):
     """Fit b, c, d of (8.2)-(8.3) to a curve A*(p*) (e.g. a BEM ensemble mean).
 
-    With a = -c and c from continuity at p* = 2, b and d are found by least squares over the points with
-    p* <= 2 from ``guess``; the larger exponent is returned as d. ``slope`` (e.g. :data:`BGT_SLOPE`) holds
-    dA*/dp* at p* = 0: d follows from b, and b alone is fitted.
+    Parameters
+    ----------
+    pstar, area : array_like
+        The curve: p* and A* [-] at the same points.
+    alpha_p, model :
+        As in :func:`curvefit_area`.
+    guess : (b, d)
+        Start of the least squares.
+    slope : float, optional
+        dA*/dp* at p* = 0 to hold (e.g. :data:`BGT_SLOPE`): d follows from b, and b alone is fitted.
+
+    Returns
+    -------
+    b, c, d : float
+        a = -c, c from continuity at p* = 2; b and d by least squares over p* <= 2, d the larger exponent.
     """
     p = np.asarray(pstar, dtype=float)
     A = np.asarray(area, dtype=float)
@@ -126,8 +174,21 @@ def fit_curvefit(pstar, area, alpha_p, guess=(-1.9, -0.05), slope=None, model=CU
 def bootstrap_curvefit(pstar, samples, alpha_p, resamples=400, seed=0, slope=None, model=CURVEFIT_MODEL):
     """The fit of :func:`fit_curvefit` to the mean of ``samples`` and its spread over the surfaces.
 
-    ``samples`` (surfaces, steps) holds A* at the load steps ``pstar``. Returns ``fit`` (b, c, d) of the mean and
-    ``draws`` (resamples, 3), the refits of the means of surfaces drawn with replacement.
+    Parameters
+    ----------
+    pstar, samples : (steps,) and (surfaces, steps) array_like
+        The load steps p* shared by every surface and A* of each surface at each step [-].
+    alpha_p, slope, model :
+        As in :func:`fit_curvefit`.
+    resamples, seed : int
+        Bootstrap resamples (surfaces drawn with replacement, their mean refitted) and their seed.
+
+    Returns
+    -------
+    fit : (b, c, d)
+        The fit of the ensemble mean.
+    draws : (resamples, 3) ndarray
+        The refits; percentiles of its columns are confidence intervals.
     """
     samples = np.asarray(samples, dtype=float)
     fit = fit_curvefit(pstar, samples.mean(axis=0), alpha_p, slope=slope, model=model)

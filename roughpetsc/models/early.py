@@ -73,11 +73,24 @@ def _evaluate(name, dstar, alpha_h, elements, e_method, slope):
 
 
 def early(name, dstar, alpha_h, elements=None, e_method="exact"):
-    """Contact ratio A* and pressure p* of an early-contact model at the separations d*, alpha^h > 3/2 (2.16).
+    """Contact ratio and pressure of an early-contact model as functions of d*.
 
-    ``name``: adapted GW (4.23)/(4.25), Nayak-Bush (4.26)-(4.27), Greenwood (4.28)-(4.29), BGT (4.30)-(4.31) or
-    asymptotic BGT (4.32)/(4.34). ``elements``: Gauss-Legendre elements per dimension. ``e_method`` (BGT): the
-    eccentricity from the root of (4.10) (reproduces Table 4.1) or from the fit (4.11) (up to ~2e-5 apart).
+    Parameters
+    ----------
+    name : {"gw", "nayak_bush", "greenwood", "bgt", "bgt_asymptotic"}
+        Adapted GW (4.23)/(4.25), Nayak-Bush (4.26)-(4.27), Greenwood (4.28)-(4.29), BGT (4.30)-(4.31) or
+        asymptotic BGT (4.32)/(4.34).
+    dstar, alpha_h : array_like, float
+        Separation d* = d / sqrt(m0^h) [-], any real value, and bandwidth alpha^h (2.16), > 3/2.
+    elements : tuple of int, optional
+        Gauss-Legendre elements per dimension.
+    e_method : {"exact", "fit"}
+        BGT: eccentricity from the root of (4.10) (reproduces Table 4.1) or the fit (4.11) (up to ~2e-5 apart).
+
+    Returns
+    -------
+    A, pstar : ndarray
+        A* [-] and p* = pbar / sqrt(m0^p) [-].
     """
     A, p, _ = _evaluate(name, dstar, alpha_h, elements, e_method, False)
     return A, p

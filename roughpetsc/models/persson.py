@@ -24,11 +24,26 @@ def fractal_moments(k_l, k_s, H, C):
 
 
 def persson_gap(pstar, k_l, k_s, H, m2, E_star, gamma=1.0, n_elements=32, order=8):
-    """Persson's mean interfacial gap g* at p* > 0, appendix E, Eq. (E.7) (k from k_l to k_s).
+    """Persson's mean interfacial gap, appendix E, Eq. (E.7) (k from k_l to k_s; exact inner integral
+    E1(p^2 / (2 m0p(k))) / 2, outer in v with k = k_l exp(v^2)).
 
-    The inner pressure integral is exact, E1(p^2 / (2 m0p(k))) / 2; the wavenumber integral uses the shared
-    rule in v with k = k_l exp(v^2), which removes the (k - k_l)^(-1/2) endpoint behaviour of 1/sqrt(m0p(k)).
-    ``k_l``, ``k_s`` in cycles per length, ``m2`` fixes C by (7.1), ``gamma`` is Persson's factor of (E.2).
+    Parameters
+    ----------
+    pstar : array_like
+        p* = pbar / sqrt(m0^p) > 0 [-], m0^p = E*^2 m2 / 2 (2.53).
+    k_l, k_s : float
+        Cut-off wavenumbers, 0 < k_l < k_s [cycles/length].
+    H, m2 : float
+        Hurst exponent, 0 < H < 1, and slope moment m2^h [-] of the whole spectrum (fixes C by (7.1)).
+    E_star, gamma : float
+        Composite modulus [pressure] (g* does not depend on it) and Persson's energy factor of (E.2).
+    n_elements, order : int
+        Gauss-Legendre elements and points per element in v.
+
+    Returns
+    -------
+    ndarray
+        g* = gbar / sqrt(m0^h) [-].
     """
     p = np.atleast_1d(np.asarray(pstar, dtype=float))
     if np.any(~(p > 0)) or not (0 < k_l < k_s) or not (0 < H < 1) or not (m2 > 0) or not (E_star > 0):

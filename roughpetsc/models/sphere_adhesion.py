@@ -190,7 +190,21 @@ def md_pulloff_dimensionless(lam, A_max=4.0, n=400):
 
 
 def md_curve(a, R, E_star, w, sigma0):
-    """Maugis-Dugdale load P [force], approach delta and Dugdale-zone radius c [length] at contact radius a > 0."""
+    """Maugis-Dugdale load, approach and Dugdale-zone radius at contact radius a.
+
+    Parameters
+    ----------
+    a : array_like
+        Contact radius [length], > 0.
+    R, E_star, w, sigma0 : float
+        Sphere radius [length], composite modulus [pressure], work of adhesion [energy/area], Dugdale stress
+        [pressure] (range h0 = w/sigma0).
+
+    Returns
+    -------
+    P, delta, c : ndarray
+        Load [force], approach and Dugdale-zone radius [length].
+    """
     lam = maugis_parameter(R, E_star, w, sigma0)
     a_s, P_s, d_s = md_scales(R, E_star, w)
     a = np.atleast_1d(np.asarray(a, float))

@@ -134,10 +134,21 @@ def _jkr_stationary_state(which, lam, h, E_star, w):
 
 
 def jkr_pulloff_load_control(lam, h, E_star, w):
-    """Load-control pull-off from partial contact, the local minimum of pbar(a) [J95]: (pbar [pressure], a [length]).
+    """Load-control pull-off from partial contact, the local minimum of pbar(a) [J95].
 
-    NaN for alpha >= ALPHA_FOLD (no local minimum). For alpha -> 0, pbar -> -3 p* (alpha/4)^(4/3) (isolated
-    JKR cylinders); for alpha >= ALPHA_SPONTANEOUS the full contact reached at zero load has no finite pull-off.
+    Parameters
+    ----------
+    lam, h : float
+        Wavelength and amplitude [length].
+    E_star, w : float
+        Composite modulus [pressure] and work of adhesion [energy/area].
+
+    Returns
+    -------
+    pbar, a : float
+        Pull-off pressure [pressure] and contact half-width [length]; NaN for alpha >= ALPHA_FOLD. For
+        alpha -> 0, pbar -> -3 p* (alpha/4)^(4/3) (isolated JKR cylinders); for alpha >= ALPHA_SPONTANEOUS
+        the full contact reached at zero load has no finite pull-off.
     """
     return _jkr_stationary_state(0, lam, h, E_star, w)
 
@@ -149,8 +160,18 @@ def jkr_jump_in(lam, h, E_star, w):
 
 
 def jkr_pulloff_displacement_control(lam, h, E_star, w):
-    """Separation under mean-gap control, the maximum of gbar(a) below the local maximum of pbar:
-    (pbar [pressure], a [length], gbar [length])."""
+    """Separation under mean-gap control, the maximum of gbar(a) below the local maximum of pbar.
+
+    Parameters
+    ----------
+    lam, h, E_star, w : float
+        As in :func:`jkr_pulloff_load_control`.
+
+    Returns
+    -------
+    pbar, a, gbar : float
+        Mean pressure [pressure], contact half-width and mean gap [length].
+    """
     alpha = johnson_alpha(lam, h, E_star, w)
     top = jkr_stationary_points(alpha)[1] if alpha < ALPHA_FOLD else np.pi / 2 - 1e-9
     f = lambda p: -jkr_mean_gap(p * lam / np.pi, lam, h, E_star, w)
@@ -190,7 +211,16 @@ class WavyMaugisDugdale:
     (MD1) pbar = p* sin^2(pi a/lam) - (2 sigma0/pi) beta, (MD2) the gap at x = c is h0; beta = pi/2 is the
     saturated state (c = lam/2). Derivation, checks and the solution set: docs/models.md.
 
-    ``n_quad`` is the half-size of the tanh-sinh rule for the two integrals.
+    Parameters
+    ----------
+    lam, h : float
+        Wavelength and amplitude [length].
+    E_star, sigma0 : float
+        Composite modulus and Dugdale stress [pressure].
+    w : float
+        Work of adhesion [energy/area].
+    n_quad : int
+        Half-size of the tanh-sinh rule for the two integrals.
     """
 
     def __init__(self, lam, h, E_star, w, sigma0, n_quad=40):
@@ -322,7 +352,13 @@ class WavyMaugisDugdale:
 
     def curve(self, n=200):
         """The contact solution set: unsaturated branches (sampled in beta), then the saturated branch a in
-        [a_saturation, lam/2], as arrays "a", "c", "beta", "pbar", "gbar" and "saturated" (bool)."""
+        [a_saturation, lam/2].
+
+        Returns
+        -------
+        dict of ndarray
+            "a", "c" [length], "beta" [-], "pbar" [pressure], "gbar" [length] and "saturated" (bool).
+        """
         rows = []
         for b1, b2 in self.beta_intervals():
             t = 0.5 - 0.5 * np.cos(np.linspace(0.0, np.pi, n))
@@ -362,8 +398,13 @@ class WavyMaugisDugdale:
 
     def pulloff(self):
         """Load-control pull-off from partial contact, the first local minimum of pbar along the unsaturated
-        branch from a = 0 (cf. :func:`jkr_pulloff_load_control`): (pbar [pressure], a [length], beta); NaN if
-        there is no unsaturated branch."""
+        branch from a = 0 (cf. :func:`jkr_pulloff_load_control`).
+
+        Returns
+        -------
+        pbar, a, beta : float
+            Pressure [pressure], contact half-width [length], beta [-]; NaN if there is no unsaturated branch.
+        """
         iv = self.beta_intervals()
         if not iv:
             return np.nan, np.nan, np.nan

@@ -15,10 +15,18 @@ from .outputs import atomic_path, jsonable
 
 
 def write(path, build, deferred=None):
-    """Write an HDF5 file atomically and durably: ``build(h5file)`` fills an empty ``h5py.File`` in memory first.
+    """Write an HDF5 file atomically and durably: ``build(h5file)`` fills it in memory first.
 
-    ``deferred``: as for :class:`roughpetsc.store.outputs.atomic_path`. Raises :class:`UserError` naming ``path``
-    if the file cannot be written.
+    Raises :class:`UserError` naming ``path`` if the file cannot be written.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file to create or replace.
+    build : callable
+        Called with an open, empty, writable ``h5py.File``.
+    deferred : list, optional
+        The temporary joins it instead of replacing ``path`` (:class:`roughpetsc.store.outputs.atomic_path`).
     """
     image = _image(build)
     with atomic_path(path, durable=True, deferred=deferred) as temporary, open(temporary, "wb") as handle:
@@ -43,11 +51,20 @@ def parallel_hdf5(comm):
 
 
 def write_distributed(path, comm, build, distributed, deferred=None):
-    """:func:`write` from every rank of ``comm`` (:func:`parallel_hdf5`), with datasets spread over the ranks.
+    """:func:`write` from every rank of ``comm``, with datasets spread over the ranks.
 
-    ``build`` runs on rank 0 and must create each dataset of ``distributed`` (name -> (local rows, first row))
-    empty, uncompressed; each rank's rows are then written collectively. Raises :class:`UserError` naming
-    ``path`` on every rank if the file cannot be written.
+    Raises :class:`UserError` naming ``path`` on every rank if the file cannot be written.
+
+    Parameters
+    ----------
+    path, deferred :
+        As for :func:`write` (``deferred`` on rank 0).
+    comm : mpi4py.MPI.Comm
+        Every rank calls this function (:func:`parallel_hdf5` is True).
+    build : callable
+        Runs on rank 0 and must create each dataset of ``distributed`` empty and uncompressed.
+    distributed : dict of name -> (local rows, first row)
+        Each rank's block of rows of a dataset, written collectively.
     """
     import h5py
 

@@ -15,14 +15,20 @@ from ..errors import ParameterError
 
 
 def load(path):
-    """Read a surface from ``.npy``, HDF5, CSV, text or an instrument file: ``(heights, length)``.
+    """Read a surface from ``.npy``, HDF5, CSV, text or an instrument file.
 
     HDF5: the dataset ``surface`` (contact-mechanics-challenge layout) or ``heights`` (a roughpetsc output, its
     root attribute ``length`` = ``[l0, l1]``). Suffixes outside :data:`TABLE_SUFFIXES` are instrument files
     (:func:`read_instrument`). CSV and text hold a height matrix (rows along y, >= 4 columns) or an ``x y z``
-    point list (:func:`points_to_grid`). ``heights`` [length] have zero mean; ``length`` is the recorded cell
-    length along x, or None. Raises :class:`ParameterError` (``path``) naming the file if it is missing,
-    unreadable or not a finite 2-D array.
+    point list (:func:`points_to_grid`). Raises :class:`ParameterError` (``path``) naming the file if it is
+    missing, unreadable or not a finite 2-D array.
+
+    Returns
+    -------
+    heights : ndarray, shape (n0, n1)
+        Heights [length], zero mean.
+    length : float or None
+        The recorded cell length along x [length], or None.
     """
     if not os.path.isfile(path):
         raise ParameterError("path", f"no such file: {path}")

@@ -52,10 +52,23 @@ DEFAULT_GENERATOR = "filter"  # the command line's embedded surface and files wr
 def fractal(grid, k_l, k_s, hurst, m2, seed, generator=DEFAULT_GENERATOR):
     """Gaussian isotropic self-affine surface of section 7.1, with the PSD (2.18) (k_r = k_l, C from (7.1)).
 
-    White Gaussian noise from ``numpy.random.default_rng(seed)`` is shaped in Fourier space. ``generator="filter"``:
-    multiplied by ``sqrt(S(k) n0 n1 / A0)``, so the *expected* spectrum is the PSD; ``"xu"``: (7.2)-(7.5) (Xu and
-    Jackson), divided by the noise's modulus first, so every realisation carries ``sqrt(S(k))`` exactly and only
-    the phase is random. Heights [length], zero mean, the same array on every rank.
+    Parameters
+    ----------
+    grid : Grid
+    k_l, k_s : float
+        Cut-off wavenumbers, 0 < k_l < k_s [cycles/length].
+    hurst, m2 : float
+        Hurst exponent H in (0, 1) and slope moment m2^h [-] (fixes C by (7.1)).
+    seed : int
+        Seed of the white Gaussian noise (``numpy.random.default_rng``) shaped in Fourier space.
+    generator : {"filter", "xu"}
+        ``"filter"``: multiplied by ``sqrt(S(k) n0 n1 / A0)``, so the *expected* spectrum is the PSD; ``"xu"``:
+        (7.2)-(7.5) (Xu and Jackson), every realisation carries ``sqrt(S(k))`` exactly, only the phase is random.
+
+    Returns
+    -------
+    ndarray, shape (n0, n1)
+        Heights [length], zero mean, the same array on every rank.
     """
     check_fractal_parameters(grid, k_l, k_s, hurst, m2)
     if generator not in GENERATORS:

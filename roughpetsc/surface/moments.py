@@ -7,11 +7,21 @@ from . import spectra
 
 
 def surface_moments(grid, heights, E_star, finite_differences=False):
-    """Moments and bandwidths of one surface (E* (1.6) [pressure]), the isotropic means of x and y.
+    """Moments and bandwidths of one surface, the isotropic means of x and y.
 
-    Returns ``m0h m2h m4h m6h`` [length^2 / length^n] (2.12), ``m0p m2p m4p`` [pressure^2 / length^n] of p_c
-    (2.47), ``alpha_h`` (2.16), ``alpha_p`` (2.54), and with ``finite_differences`` ``alpha_h_fd``, ``alpha_p_fd``
-    from the finite-difference moments (7.6)/(7.7) (the "Num" values of Table 7.7).
+    Parameters
+    ----------
+    grid : Grid
+    heights, E_star : ndarray, float
+        Heights [length] on ``grid`` and the composite modulus E* (1.6) [pressure].
+    finite_differences : bool
+        Also ``alpha_h_fd``, ``alpha_p_fd`` from the finite-difference moments (7.6)/(7.7) ("Num" of Table 7.7).
+
+    Returns
+    -------
+    dict
+        ``m0h m2h m4h m6h`` [length^2 / length^n] (2.12), ``m0p m2p m4p`` [pressure^2 / length^n] of p_c (2.47),
+        ``alpha_h`` (2.16), ``alpha_p`` (2.54) [-].
     """
     if finite_differences:
         summary = spectra.surface_moment_summary(grid, heights, E_star)

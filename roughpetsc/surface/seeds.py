@@ -18,7 +18,18 @@ RULE = ("seed_i = SeedSequence(ensemble_seed, spawn_key=(i,)).generate_state(1, 
 
 
 def surface_seed(master, index):
-    """The white-noise seed in [0, 2**31) of realisation ``index`` >= 0 of the ensemble with master seed ``master``."""
+    """The white-noise seed of realisation ``index`` of the ensemble with master seed ``master``.
+
+    Parameters
+    ----------
+    master, index : int
+        Master seed and realisation, >= 0.
+
+    Returns
+    -------
+    int
+        In [0, 2**31): the first 31-bit word of ``SeedSequence(master).spawn(index + 1)[index]``.
+    """
     sequence = np.random.SeedSequence(master, spawn_key=(index,))
     return int(sequence.generate_state(1, np.uint32)[0] & SEED_BITS)
 

@@ -111,8 +111,18 @@ def fit_fractal_psd(grid, field, band):
 def spectral_moments(grid, field, orders=MOMENT_ORDERS):
     """Directional spectral moments ``m_n0`` (x) and ``m_0n`` (y) of a periodic field, eq. (2.12)/(2.13).
 
-    Returns ``{"x": {n: m_n0}, "y": {n: m_0n}}`` in [field]^2 / length^n, from :func:`power_spectrum`
-    without the k = 0 mode (``m_0`` is the variance).
+    Parameters
+    ----------
+    grid : Grid
+    field : ndarray, shape grid.shape
+        Heights [length] or pressures [pressure].
+    orders : sequence of even int
+
+    Returns
+    -------
+    dict
+        ``{"x": {n: m_n0}, "y": {n: m_0n}}`` [field^2 / length^n], from :func:`power_spectrum` without the
+        k = 0 mode (``m_0`` is the variance).
     """
     k0, k1 = grid.rfft_wavenumbers()
     power = power_spectrum(grid, field).copy()  # C order (rfft2's is not): the order of the sums below
@@ -123,10 +133,22 @@ def spectral_moments(grid, field, orders=MOMENT_ORDERS):
 
 
 def fd_derivative(field, spacing, axis, order, scheme=SEED_STENCILS):
-    """Periodic finite-difference derivative of order 1, 2 or 3 along ``axis`` (node spacing Delta [length]).
+    """Periodic finite-difference derivative along one axis.
 
-    ``scheme="seed"``: ``(f[i+1] - f[i-1]) / (2 Delta)``, ``(f[i+1] - 2 f[i] + f[i-1]) / Delta^2`` and the
-    central difference of the latter for order 3; ``"central"``: the central difference ``order`` times.
+    Parameters
+    ----------
+    field, spacing : ndarray, float
+        The field and its node spacing Delta along ``axis`` [length].
+    axis, order : int
+        0 (y, rows) or 1 (x); order 1, 2 or 3.
+    scheme : {"seed", "central"}
+        ``"seed"``: ``(f[i+1] - f[i-1]) / (2 Delta)``, ``(f[i+1] - 2 f[i] + f[i-1]) / Delta^2`` and the central
+        difference of the latter for order 3; ``"central"``: the central difference ``order`` times.
+
+    Returns
+    -------
+    ndarray, same shape
+        [field] / length^order.
     """
     if scheme not in FD_SCHEMES:
         raise ParameterError("scheme", f"unknown finite-difference scheme {scheme!r}; use one of {FD_SCHEMES}")
@@ -152,9 +174,21 @@ def fd_derivative(field, spacing, axis, order, scheme=SEED_STENCILS):
 
 
 def fd_moments(grid, field, orders=MOMENT_ORDERS, scheme=SEED_STENCILS):
-    """Directional moments by finite differences, eqs. (7.6) (x) and (7.7) (y), as :func:`spectral_moments`.
+    """Directional moments by finite differences, eqs. (7.6) (x) and (7.7) (y): ``m_n0 = < (d^(n/2) f / dx^(n/2))^2 >``
+    over the nodes, ``m_0 = <(f - <f>)^2>``.
 
-    ``m_n0 = < (d^(n/2) f / dx^(n/2))^2 >`` over the nodes (:func:`fd_derivative`); ``m_0 = <(f - <f>)^2>``.
+    Parameters
+    ----------
+    grid, field :
+        As in :func:`spectral_moments`.
+    orders : sequence of even int in (0, 2, 4, 6)
+    scheme : {"seed", "central"}
+        See :func:`fd_derivative`.
+
+    Returns
+    -------
+    dict
+        ``{"x": {n: m_n0}, "y": {n: m_0n}}`` [field^2 / length^n].
     """
     spacing = {"x": grid.l1 / grid.n1, "y": grid.l0 / grid.n0}
     variance = float(np.mean((field - field.mean()) ** 2))
@@ -252,7 +286,17 @@ def pressure_moment_from_heights(n, height_moments, e_star=1.0):
 def fractal_closed_forms(k_l, k_s, hurst, amplitude, e_star=1.0):
     """All closed forms of a fractal group: m_n^h (2.21-2.24), alpha^h (2.25), m_n^p (2.56-2.58), alpha^p (2.59).
 
-    Returns ``{"h": {0, 2, 4, 6: m_n^h}, "p": {0, 2, 4: m_n^p}, "alpha_h", "alpha_p"}``.
+    Parameters
+    ----------
+    k_l, k_s, hurst : float
+        As in :func:`fractal`.
+    amplitude, e_star : float
+        PSD amplitude C of (2.18) and composite modulus E* (1.6) [pressure].
+
+    Returns
+    -------
+    dict
+        ``"h"`` ({0, 2, 4, 6: m_n^h}), ``"p"`` ({0, 2, 4: m_n^p}), ``"alpha_h"`` and ``"alpha_p"``.
     """
     return {
         "h": {n: fractal_height_moment(n, k_l, k_s, hurst, amplitude) for n in MOMENT_ORDERS},
@@ -265,10 +309,21 @@ def fractal_closed_forms(k_l, k_s, hurst, amplitude, e_star=1.0):
 # --- Pressure surface
 
 def pressure_surface(grid, heights, e_star=1.0):
-    """Complete-contact pressure p_c = F^-1[pi E* k F[h]] [pressure], zero mean, eq. (2.47); E* (1.6).
+    """Complete-contact pressure p_c = F^-1[pi E* k F[h]], eq. (2.47) (over the ranks:
+    :meth:`roughpetsc.westergaard.Westergaard.pressure_surface`).
 
-    The dissertation's "pressure surface" is ``-p_c``; the solver applies the same symbol over the ranks
-    (:meth:`roughpetsc.westergaard.Westergaard.pressure_surface`).
+    Parameters
+    ----------
+    grid : Grid
+    heights : ndarray, shape grid.shape
+        Heights [length].
+    e_star : float
+        Composite modulus E* (1.6) [pressure].
+
+    Returns
+    -------
+    ndarray, shape grid.shape
+        p_c [pressure], zero mean; the dissertation's "pressure surface" is ``-p_c``.
     """
     return np.fft.irfft2(np.fft.rfft2(heights) * complete_contact_symbol(grid, e_star), s=grid.shape)
 
@@ -280,10 +335,19 @@ def complete_contact_symbol(grid, e_star):
 
 
 def heights_from_pressure_surface(grid, complete_contact_pressure, e_star=1.0):
-    """Zero-mean heights [length] whose complete-contact pressure is the given field (:func:`pressure_surface`).
+    """Zero-mean heights whose complete-contact pressure is the given field: the inverse of :func:`pressure_surface`.
 
-    h = F^-1[F[p_c] / (pi E* k)] without the k = 0 mode, so ``pressure_surface(grid, h, e_star)`` returns
-    ``p_c - mean(p_c)``: a nearly complete contact with a prescribed traction on its cracks (chapters 5-6).
+    Parameters
+    ----------
+    grid, e_star :
+        As in :func:`pressure_surface`.
+    complete_contact_pressure : ndarray, shape grid.shape
+        p_c [pressure].
+
+    Returns
+    -------
+    ndarray, shape grid.shape
+        h = F^-1[F[p_c] / (pi E* k)] [length] without the k = 0 mode: its p_c is ``p_c - mean(p_c)``.
     """
     symbol = complete_contact_symbol(grid, e_star)
     symbol[0, 0] = 1.0
