@@ -124,7 +124,8 @@ def least_curvature(problem, gap, s1, mode=None):
 
 
 class _PC:
-    """PCPYTHON context: the projected compliance."""
+    """PCPYTHON context: the projected compliance (a separate object: the MATPYTHON context given as a PCPYTHON
+    one too crashed PETSc)."""
 
     def __init__(self, context):
         self.context = context
