@@ -7,7 +7,7 @@ from petsc4py import PETSc
 
 from ..errors import UserError
 from ..solvers.options import FINALIZE_OPTIONS, petsc_library, read_late, unused_options
-from ..solvers.stopping import KIND_WORDS, check_int_range
+from ..solvers.stopping import read_option
 from ..contact.loads import LIST_FILE_PREFIX, parse_reals
 
 # Prefixes of options that PETSc objects or PETSc itself read.
@@ -27,28 +27,19 @@ class Reader:
     def __init__(self, database=None):
         self.database = database or PETSc.Options()
 
-    def _get(self, getter, name, default, kind=None):
-        try:
-            return getter(name, default)
-        except PETSc.Error:
-            what = f" as {KIND_WORDS[kind]}" if kind else ""
-            raise UserError(f"-{name}: cannot read the value '{self.database.getString(name, '')}'{what}") from None
-
     def getReal(self, name, default):
-        return self._get(self.database.getReal, name, default, "Real")
+        return read_option(self.database, "Real", name, default)
 
     def getInt(self, name, default):
-        value = self._get(self.database.getInt, name, default, "Int")
-        check_int_range(self.database, name, value)
-        return value
+        return read_option(self.database, "Int", name, default)
 
     def getString(self, name, default):
         """The value of ``-name`` as given (any length), or ``default`` if the option is absent."""
-        text = self._get(self.database.getString, name, default)
+        text = self.database.getString(name, default)
         return whole_string(name, text, self.database.prefix) if self.database.hasName(name) else text
 
     def getBool(self, name, default):
-        return self._get(self.database.getBool, name, default, "Bool")
+        return read_option(self.database, "Bool", name, default)
 
     def hasName(self, name):
         return self.database.hasName(name)
