@@ -69,7 +69,14 @@ class Westergaard(FilterOperator):
         """The (constant) diagonal of the compliance matrix: mean of its symbol over the full spectrum."""
         k = wavenumber_modulus(self.grid)
         with np.errstate(divide="ignore"):
-            symbol = np.where(k > 0, 1.0 / (np.pi * self.E_star * k), 0.0)
+            return self._spectral_mean(np.where(k > 0, 1.0 / (np.pi * self.E_star * k), 0.0))
+
+    @property
+    def stiffness_diagonal(self):
+        """The (constant) diagonal of the stiffness matrix S of :meth:`elastic_pressure`."""
+        return self._spectral_mean(np.pi * self.E_star * wavenumber_modulus(self.grid))
+
+    def _spectral_mean(self, symbol):
         # rfft layout: a column that stands for two modes of the full spectrum counts twice.
         return float((symbol * rfft_multiplicity(self.grid.n1)).sum() / self.grid.size)
 

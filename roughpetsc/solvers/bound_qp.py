@@ -31,7 +31,12 @@ FOURIER_DEFAULT_TYPES = ("bnls", "bntr", "bntl")
 QUASI_NEWTON_TYPES = ("blmvm", "bqnls", "bqnkls", "bqnktr", "bqnktl")
 BOUND_PRECONDITIONERS = ("fourier", "none", "options")
 INITIAL_HESSIANS = ("fourier", "none")
-LOAD_METHODS = ("al", "rootfind")
+LOAD_METHODS = ("al", "rootfind", "gap")
+# The types whose load control is in the gap by default where it applies: against the augmented Lagrangian it
+# took 0.31-0.64x the FFT pairs of BLMVM, BQNLS and TRON at N = 512 and 1024, p* = 0.05-2 (group #1), and
+# 0.99x of TRON at p* = 0.05; GPCG converged at p* = 0.5 and 2, where it stalls with the multiplier (at
+# p* = 0.05 on 512^2 it ran out of 200 s, which the multiplier did not).
+GAP_DEFAULT_TYPES = ("blmvm", "bqnls", "tron", "gpcg")
 # Bounds of the initial Hessian's scale gamma; it settled at 0.1-0.3 in the solves measured.
 GAMMA_BOUNDS = (1e-3, 1e3)
 # The default penalty c of the augmented Lagrangian (units of L / pi): with the Fourier H0, BLMVM and BQNLS took
@@ -53,9 +58,11 @@ OPTIONS = [
                      "types) | none (default of tron, gpcg) | options (-tao_*pc_type decides)"),
     ("bound_h0", "", "TAO blmvm/bqnls/bqnk*: initial Hessian of L-BFGS: fourier (Polonsky-Keer's preconditioner on "
                      "the free set, their default) | none (PETSc's)"),
-    ("bound_load", "al", "TAO bound types under load control: al (augmented Lagrangian on mean(p) = pbar inside "
-                         "the solve) | rootfind (a safeguarded root find on the separation around displacement "
-                         "control)"),
+    ("bound_load", "", "TAO bound types under load control: gap (one solve for the gap, whose gradient is the "
+                       "pressure of mean pbar; periodic boundary without a hardness cap; default of blmvm, bqnls, "
+                       "tron, gpcg there) | al (augmented Lagrangian on mean(p) = pbar inside the solve; default "
+                       "otherwise) | rootfind (a safeguarded root find on the separation around displacement "
+                       "control)"),
     ("bound_al_penalty", "", "augmented Lagrangian: penalty c in units of the compliance of the longest wavelength "
                              "(default 0.1 for the quasi-Newton types with the Fourier H0, 1 for the others)"),
     ("bound_al_eta", "", "augmented Lagrangian: an inner solve stops once its natural residual is below this "
@@ -116,24 +123,33 @@ class AugmentedQuadratic:
         """Forget the cached point: the next evaluated point has f = 0 (a new TAO solve)."""
         self.cached = False
 
-    def evaluate(self, x, out):
-        """``out = g(x)`` (one operator application); returns f(x)."""
+    def _apply(self, x, out):
+        """``out = K x``; returns the heights and the separation of ``g = K x - h + separation``."""
         problem = self.problem
-        x_local = x.getArray(readonly=True)
         separation = self.lam
         if self.penalty:
-            total, = allsum(problem.mpi, [loops.local_sum(x_local)])
+            total, = allsum(problem.mpi, [loops.local_sum(x.getArray(readonly=True))])
             separation += self.penalty * (total / problem.n - self.pbar)
         problem.operator.displacement(x, out)
-        out_local = out.getArray()
         if self.initial_lam:
             elastic = problem.local(self.scratch)
-            np.subtract(out_local.reshape(elastic.shape), problem.local(problem.heights, readonly=True), out=elastic)
+            np.subtract(problem.local(out, readonly=True), problem.local(problem.heights, readonly=True), out=elastic)
             self.lam = problem.contact_separation(x, elastic)
             self.initial_lam = False
             separation += self.lam
-        sums = loops.gradient_step(x_local, self.point.getArray(), self.gap.getArray(), out_local,
-                                   problem.heights.getArray(readonly=True), separation, out_local, self.cached)
+        return problem.heights.getArray(readonly=True), separation
+
+    def _separation(self, offset, total):
+        """The rigid separation d of the point whose gradient's offset is ``offset`` and sum ``total``."""
+        return offset
+
+    def evaluate(self, x, out):
+        """``out = g(x)`` (one operator application); returns f(x)."""
+        problem = self.problem
+        heights, offset = self._apply(x, out)
+        out_local = out.getArray()
+        sums = loops.gradient_step(x.getArray(readonly=True), self.point.getArray(), self.gap.getArray(), out_local,
+                                   heights, offset, out_local, self.cached)
         before, after, total = allsum(problem.mpi, sums)
         self.value = self.value + 0.5 * (before + after) if self.cached else 0.0
         if self.probe_armed and self.cached:
@@ -141,7 +157,7 @@ class AugmentedQuadratic:
             self.probe_ratio = -before / (after - before) if after > before else None
             self.probe_armed = False
         self.cached = True
-        self.total, self.separation = total, separation
+        self.total, self.separation = total, self._separation(offset, total)
         self.vec_handle, self.state = x.handle, x.stateGet()
         return self.value
 
@@ -195,6 +211,8 @@ class FourierInitialHessian(PenalizedCompliance):
     """MATPYTHON context of the quasi-Newton types' initial Hessian: ``mult`` the exact Hessian, ``solve``
     gamma times Polonsky-Keer's approximation of its inverse on the current free set (docs/solvers.md)."""
 
+    mean_mode_weight = MEAN_MODE_WEIGHT
+
     def __init__(self, problem, objective):
         super().__init__(problem)
         self.objective = objective
@@ -229,15 +247,23 @@ class FourierInitialHessian(PenalizedCompliance):
             return
         mean = total / count
         loops.shift_on(residual, self.mask, mean, residual)  # P r: zero mean on the free set
-        shape = problem.operator.local_shape
-        problem.operator.stiffness(residual.reshape(shape), out.reshape(shape))
+        self._inverse_on_free(self.residual, x)
         out_mean = allsum(mpi, [loops.masked_sum(out, self.mask)])[0] / count
+        mean_term = self.mean_mode_weight * mean / self._mean_mode_curvature(count)
+        loops.finish_initial_hessian(out, source, self.mask, out_mean, mean_term, self.fixed_scale, self.gamma)
+
+    def _inverse_on_free(self, residual, out):
+        """``out`` = the approximate inverse of the Hessian applied to ``residual`` (zero mean on the free set)."""
+        shape = self.problem.operator.local_shape
+        self.problem.operator.stiffness(residual.getArray(readonly=True).reshape(shape), out.getArray().reshape(shape))
+
+    def _mean_mode_curvature(self, count):
+        """The Hessian's curvature on the uniform field of the free set (``mask``, ``count`` nodes): its compliance."""
         self.fourier.penalty = self.penalty
         compliance = self.fourier.mean_mode_compliance(self.mask, count)
         if not np.isfinite(compliance):
             compliance = self.penalty if self.penalty else self.longest_compliance
-        mean_term = MEAN_MODE_WEIGHT * mean / compliance
-        loops.finish_initial_hessian(out, source, self.mask, out_mean, mean_term, self.fixed_scale, self.gamma)
+        return compliance
 
     def destroy(self, mat=None):
         self.residual.destroy()
@@ -342,6 +368,8 @@ def next_multiplier(points, pbar, separation, stiffness=None, touch=None):
 class BoundQP(Backend):
     """A bound-constrained TAO type under load (augmented Lagrangian) or displacement control."""
 
+    objective_type, hessian_type, initial_hessian_type = AugmentedQuadratic, PenalizedCompliance, FourierInitialHessian
+
     def __init__(self, problem, control, tao_type, settings):
         self.problem = problem
         self.control = control
@@ -357,17 +385,16 @@ class BoundQP(Backend):
         self.max_outer = read_option(options, "Int", "bound_al_max_outer", 40)
         self.recycle = read_option(options, "Bool", "bound_al_recycle", False)
         self.newton = read_option(options, "Bool", "bound_al_newton", True)
-        preconditioner = options.getString("bound_pc", "") or \
-            ("fourier" if tao_type in FOURIER_DEFAULT_TYPES else "none")
+        preconditioner = options.getString("bound_pc", "") or self._default_preconditioner(tao_type)
         self._check_options(h0, preconditioner)
-        self.objective = AugmentedQuadratic(problem)
+        self.objective = self.objective_type(problem)
         self.stiffness_preconditioner = FourierPreconditioner(problem)
         self.buffers = (problem.vec(), problem.vec())  # the best iterate is in buffers[best]
         self.best = 0
         self.lower, self.upper, self.gradient = problem.vec(), problem.vec(), problem.vec()
         self.lower.set(0.0)
         self.upper.set(PETSc.INFINITY if problem.upper_bound is None else problem.upper_bound)
-        self.hessian_context = PenalizedCompliance(problem)
+        self.hessian_context = self.hessian_type(problem)
         self.hessian = problem.operator.mat(self.hessian_context)
         self.fourier = self.preconditioning = None
         self.initial_context = self.initial_hessian = None
@@ -390,10 +417,14 @@ class BoundQP(Backend):
         with default_options(self._default_options(tao_type, h0), settings.prefix):
             set_from_options(tao, self.destroy)
         if quasi_newton_h0:
-            self.initial_context = FourierInitialHessian(problem, self.objective)
+            self.initial_context = self.initial_hessian_type(problem, self.objective)
             self.initial_hessian = problem.operator.mat(self.initial_context)
             _set_lmvm_initial_hessian(tao, tao_type, self.initial_hessian)
         self.name = tao.getType() + ("(al)" if control == "load" else "")
+
+    @staticmethod
+    def _default_preconditioner(tao_type):
+        return "fourier" if tao_type in FOURIER_DEFAULT_TYPES else "none"
 
     @staticmethod
     def _default_options(tao_type, h0):
@@ -562,7 +593,9 @@ class BoundQP(Backend):
 
 def make_bound(problem, control, tao_type, settings):
     """The bound type ``tao_type``: :class:`BoundQP`, or under load control with ``-bound_load rootfind`` RootFind."""
-    method = PETSc.Options(settings.prefix).getString("bound_load", "al")
+    gap_applies = getattr(problem, "boundary", None) == "periodic" and getattr(problem, "upper_bound", None) is None
+    method = PETSc.Options(settings.prefix).getString("bound_load", "") or \
+        ("gap" if gap_applies and tao_type in GAP_DEFAULT_TYPES else "al")
     if method not in LOAD_METHODS:
         raise UserError(f"{option_name('bound_load', settings.prefix)}: unknown method '{method}' "
                         f"(one of {', '.join(LOAD_METHODS)})")
@@ -570,6 +603,10 @@ def make_bound(problem, control, tao_type, settings):
         from .root_find import RootFind
 
         return RootFind(problem, control, tao_type, settings)
+    if control == "load" and method == "gap":  # under displacement control every method is the same QP
+        from .bound_gap import GapLoadQP
+
+        return GapLoadQP(problem, control, tao_type, settings)
     return BoundQP(problem, control, tao_type, settings)
 
 

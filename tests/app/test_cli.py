@@ -130,11 +130,11 @@ def test_bad_input_gives_one_clear_message(tmp_path, args, ranks, named):
 @pytest.mark.mpi
 @pytest.mark.slow
 def test_headline_usage_bqnls_on_two_ranks(tmp_path):
-    """`mpiexec -n 2 python -m roughpetsc -tao_type bqnls`: load control by BQNLS inside an augmented Lagrangian."""
+    """`mpiexec -n 2 python -m roughpetsc -tao_type bqnls`: load control by BQNLS in one solve for the gap."""
     out = run_cli(SMALL + ["-tao_type", "bqnls", "-json", tmp_path / "b.json"], ranks=2)
     assert out.returncode == 0, out.stderr
     step = json.load(open(tmp_path / "b.json"))["steps"][0]
-    assert step["solver"] == "bqnls(al)" and step["converged"]
+    assert step["solver"] == "bqnls(gap)" and step["converged"]
     assert step["pstar"] == pytest.approx(0.5, rel=1e-8)
 
 

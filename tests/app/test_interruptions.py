@@ -246,7 +246,8 @@ def test_progress_can_be_forced_off_and_on(tmp_path):
 def test_progress_names_the_inner_solves_of_a_root_find():
     """Under load control a TAO bound type solves several displacement problems in a row (one per multiplier
     of its augmented Lagrangian), and the progress line counts them."""
-    out = run_cli(TINY + ["-pstar", 0.4, "-tao_type", "blmvm", "-progress", "on", "-progress_interval", 1e-9])
+    out = run_cli(TINY + ["-pstar", 0.4, "-tao_type", "blmvm", "-bound_load", "al", "-progress", "on",
+                          "-progress_interval", 1e-9])
     assert out.returncode == 0, out.stderr
     inner = {int(line.split("inner solve ")[1].split(",")[0]) for line in out.stdout.splitlines() if "... step" in line}
     assert len(inner) >= 3 and inner == set(range(1, max(inner) + 1))

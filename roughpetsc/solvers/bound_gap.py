@@ -1,0 +1,208 @@
+"""Load control of every bound-constrained TAO type in the gap: one TAO solve holds mean(p) = pbar exactly.
+
+On the periodic cell, with the stiffness S (symbol pi E* |k|, zero on the mean) and the gap g = K p + d - h,
+the pressure is p = pbar + S (g + h). The gap g >= 0 that minimises
+
+    Pi(g) = 1/2 (g + h)' S (g + h) + pbar sum(g)
+
+has the gradient p, so the KKT conditions of Pi are those of the contact problem (3.41)-(3.44): g >= 0, p >= 0,
+g p = 0, and mean(p) = pbar holds at every iterate. Its Hessian is S. The Newton types run without a
+preconditioner. The quasi-Newton types get the compliance K on the free set as initial Hessian: the mirror of
+:class:`~.bound_qp.FourierInitialHessian`, which applies S in the pressure. This works on the periodic boundary
+without a hardness cap only: the free boundary's stiffness is no Fourier filter, and a cap bounds p, which is
+the gradient here, not the unknown. See docs/solvers.md.
+"""
+
+import math
+
+import numpy as np
+
+from ..contact import loops
+from ..errors import UserError
+from ..parallel import allmax, allsum
+from .bound_qp import AugmentedQuadratic, BoundQP, FourierInitialHessian, PenalizedCompliance, _set_recycle
+from .protocol import Outcome
+from .stopping import ConvergenceTest, History, describe_stop, option_name
+
+# Weight of the free set's uniform mode in the initial Hessian. BLMVM at N = 256, p* = 0.5 (group #1) took
+# 239 / 201 / 162 FFT pairs at 0.3 / 1 / 3, and stopped on a failed line search at 8.
+GAP_MEAN_MODE_WEIGHT = 3.0
+
+
+class GapQuadratic(AugmentedQuadratic):
+    """Pi(g) of the module docstring and its gradient p; the separation of a point is d = mean(g) + mean(h)."""
+
+    def __init__(self, problem):
+        super().__init__(problem)
+        self.loaded_heights = problem.vec()  # -S h, as the gradient's kernel subtracts its heights
+        problem.operator.elastic_pressure(problem.heights, self.loaded_heights)
+        self.loaded_heights.scale(-1.0)
+        self.mean_height = problem.heights.sum() / problem.n
+
+    def _apply(self, x, out):
+        self.problem.operator.elastic_pressure(x, out)
+        return self.loaded_heights.getArray(readonly=True), self.pbar
+
+    def _separation(self, offset, total):
+        return total / self.problem.n + self.mean_height
+
+    def destroy(self):
+        super().destroy()
+        self.loaded_heights.destroy()
+
+
+class _Stiffness:
+    """The Hessian S of Pi (+ BNK's shift) as a MATPYTHON context's ``mult`` and ``getDiagonal``."""
+
+    def mult(self, mat, x, y):
+        self.problem.operator.elastic_pressure(x, y)
+        if self.perturbation:
+            y.axpy(self.perturbation, x)
+
+    def getDiagonal(self, mat, d):
+        d.set(self.problem.operator.stiffness_diagonal + self.perturbation)
+
+
+class GapHessian(_Stiffness, PenalizedCompliance):
+    """MATPYTHON context: the Hessian S of Pi."""
+
+
+class GapInitialHessian(_Stiffness, FourierInitialHessian):
+    """The quasi-Newton types' initial Hessian in the gap: gamma K on the free set (zero mean there), the free
+    set's uniform mode by its stiffness, gamma / diag(S) off it."""
+
+    mean_mode_weight = GAP_MEAN_MODE_WEIGHT
+
+    def __init__(self, problem, objective):
+        super().__init__(problem, objective)
+        self.fixed_scale = 1.0 / problem.operator.stiffness_diagonal
+        self.indicator, self.response = problem.vec(), problem.vec()
+        self._mean_mode = (0.0, 1.0)  # (|F| it was computed for, its compliance)
+        grid = problem.scaled_grid
+        self.longest_compliance = max(grid.l0, grid.l1) / np.pi
+
+    def _inverse_on_free(self, residual, out):
+        self.problem.operator.displacement(residual, out)
+
+    def _mean_mode_curvature(self, count):
+        """1_C' S 1_C / |F|, the stiffness of the uniform gap on the free set F (C the fixed nodes): recomputed,
+        one operator application, when |F| changed by more than 5 %; without fixed nodes, that of the longest
+        wavelength."""
+        computed_for, stiffness = self._mean_mode
+        if abs(count - computed_for) <= 0.05 * count:
+            return stiffness
+        problem = self.problem
+        fixed = problem.local(self.indicator).ravel()
+        np.subtract(1.0, self.mask, out=fixed)
+        problem.operator.elastic_pressure(self.indicator, self.response)
+        energy, = allsum(problem.mpi, [np.dot(problem.local(self.response, readonly=True).ravel(), fixed)])
+        stiffness = energy / count if energy > 0 else 1.0 / self.longest_compliance
+        self._mean_mode = (count, stiffness)
+        return stiffness
+
+    def destroy(self, mat=None):
+        super().destroy(mat)
+        self.indicator.destroy()
+        self.response.destroy()
+
+
+class GapLoadQP(BoundQP):
+    """A bound-constrained TAO type under load control, solved for the gap (module docstring)."""
+
+    objective_type, hessian_type, initial_hessian_type = GapQuadratic, GapHessian, GapInitialHessian
+
+    def __init__(self, problem, control, tao_type, settings):
+        name = option_name("bound_load", settings.prefix)
+        where = name + " gap"
+        if control != "load":
+            raise UserError(f"{where} is a method of load control")
+        if problem.boundary != "periodic" or problem.upper_bound is not None:
+            raise UserError(f"{where} needs the periodic boundary without a hardness cap (the free boundary's "
+                            f"stiffness is no Fourier filter; a cap bounds the pressure, which is the gradient "
+                            f"there): use {name} al")
+        super().__init__(problem, control, tao_type, settings)
+        self.variable, self.reported = problem.vec(), problem.vec()
+        self.ratio = 1.0  # of the reported pressure's natural residual to the iterate's, as last measured
+        self.name = self.tao.getType() + "(gap)"
+
+    @staticmethod
+    def _default_preconditioner(tao_type):
+        return "none"
+
+    def _check_options(self, h0, preconditioner):
+        super()._check_options(h0, preconditioner)
+        if preconditioner == "fourier":
+            raise UserError(f"{option_name('bound_pc', self.prefix)} fourier preconditions the pressure's QP; "
+                            f"with {option_name('bound_load', self.prefix)} gap use none or options")
+
+    def _natural_residual(self, tao):
+        """``(natural, load error, fresh)`` of the pressure the iterate would report, on its own fresh gap.
+
+        The iterate (the gap) goes to the spare buffer in the same pass. Its residual in (g, gradient) is scaled
+        by the last measured ratio of the reported pressure's residual to it (the pressure zeroed off contact
+        moves the gap by K of its small remainder, mostly long waves); once that estimate is within the
+        tolerance, the reported pressure's is measured, one operator application.
+        """
+        x = tao.getSolution()
+        gradient, _, separation = self.objective.cached_gap(x)
+        pbar = self.objective.pbar
+        # natural_and_copy scales its first argument by 1 / scale: min(p, pbar g) / pbar = min(p / pbar, g).
+        local = loops.natural_and_copy(x.getArray(readonly=True), gradient, 1.0 / pbar, math.inf,
+                                       self.buffers[1 - self.best].getArray()) / pbar
+        natural, = allmax(self.problem.mpi, [local])
+        estimate, load_error = natural * self.ratio, None
+        if estimate <= self.rule.rtol:
+            estimate, load_error = self._reported_residual(x, gradient, pbar, separation)
+            self.ratio = max(self.ratio, estimate / natural) if natural > 0 else self.ratio
+        self.last = (estimate, load_error, pbar, separation)
+        return estimate, load_error, True
+
+    def _reported_residual(self, gap, gradient, pbar, separation):
+        """The natural residual and load error of the reported pressure on its fresh gap."""
+        problem = self.problem
+        pressure, fresh = self.reported, self.objective.scratch
+        self._report(gap.getArray(readonly=True), gradient, pbar, pressure.getArray())
+        problem.gap(pressure, separation, fresh)
+        total, = allsum(problem.mpi, [pressure.getArray(readonly=True).sum()])
+        local = loops.natural_and_copy(pressure.getArray(readonly=True), fresh.getArray(readonly=True), pbar,
+                                       math.inf, fresh.getArray())
+        natural, = allmax(problem.mpi, [local])
+        return natural, abs(total / problem.n - pbar) / pbar
+
+    @staticmethod
+    def _report(gap, gradient, pbar, out):
+        """The pressure reported for a gap: its gradient where that exceeds pbar g (the side of the natural
+        residual's min that says "in contact"), zero elsewhere, as A counts p > 0."""
+        np.copyto(out, np.where(gradient > pbar * gap, gradient, 0.0))
+
+    def solve(self, target, pressure, guess=None, history=None):
+        """Solve for the mean pressure ``target`` from ``pressure`` (overwritten with the solution).
+
+        The start is the gap of ``pressure`` at the guessed separation (at the highest summit without one),
+        clipped at zero: one operator application.
+        """
+        problem = self.problem
+        history = history or History(problem)
+        test = ConvergenceTest(self.rule.watch(history), self._natural_residual, keep_best=self._keep_best)
+        self.tao.setConvergenceTest(test)
+        self.last = None
+        self.ratio = 1.0
+        self.objective.configure(0.0, 0.0, target)
+        gap = self.variable
+        separation = guess.separation if guess is not None and guess.separation is not None else problem.max_height
+        problem.gap(pressure, separation, gap)
+        np.maximum(problem.local(gap), 0.0, out=problem.local(gap))
+        _set_recycle(self.tao, False)
+        iterations, restarts = self._run(gap, test)
+        reason = self.tao.getConvergedReason()
+        if reason < 0 and np.isfinite(test.watch.best_natural):
+            self.buffers[self.best].copy(gap)
+        gradient, _, separation = self.objective.cached_gap(gap)
+        self._report(gap.getArray(readonly=True), gradient, target, pressure.getArray())
+        return Outcome(separation, iterations, describe_stop(reason, test.watch, restarts, load_control=True),
+                       history.as_array())
+
+    def destroy(self):
+        super().destroy()
+        self.variable.destroy()
+        self.reported.destroy()
