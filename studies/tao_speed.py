@@ -1,19 +1,21 @@
 """TAO's bound types against Polonsky-Keer under load and displacement control, before and after issue 40.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python studies/tao_speed.py [--sizes 512 1024] [--pstars 0.05 0.5 2]
-        [--solvers blmvm bqnls gpcg tron] [--variants after before] [--max-time 600] [--profile 1024] [--report]
+        [--solvers blmvm bqnls gpcg tron] [--variants after al before] [--max-time 600] [--profile 1024] [--report]
 
 Group #1 surface (seed 1), natural KKT residual 1e-8, FFTW_MEASURE plans remembered in the wisdom cache (so the
 iterates repeat from the second run of a size on). Per N and p*: Polonsky-Keer (the default solver) under load
 control gives the separation d; every solver then solves the load (``pstar``) and the QP at d, cold. Variants:
-``after``, ``-tao_type <type>`` as it is (roughpetsc/solvers/bound_qp.py: the augmented Lagrangian on
-mean(p) = pbar, the Fourier initial Hessian of the quasi-Newton types, fused callbacks); ``before``, the
-former methods as options still select them (``-bound_load rootfind -bound_h0 none``: a root find on d around
-each type, PETSc's initial Hessian). The ``before`` rows of the committed tao_speed.json and the profile were
-measured on the code before these changes (commit 4c0fa30: unfused callbacks too), so they show the whole
-gain; a rerun of ``before`` now measures the former methods with the fused callbacks. ``--profile N``
-counts PETSc's vector operations and times our events per iteration for PK, BLMVM and BQNLS under
-displacement control at N, p* = 0.5 (the -log_view breakdown, read through petsc4py's log).
+``after``, ``-tao_type <type>`` as it is (load control in the gap for BLMVM, BQNLS, TRON and GPCG,
+roughpetsc/solvers/bound_gap.py; the Fourier initial Hessian of the quasi-Newton types, fused callbacks);
+``al``, load control by the augmented Lagrangian on mean(p) = pbar (``-bound_load al``, bound_qp.py; its
+displacement control is ``after``'s); ``before``, the former methods as options still select them
+(``-bound_load rootfind -bound_h0 none``: a root find on d around each type, PETSc's initial Hessian).
+The ``before`` rows of the committed tao_speed.json and the profile were measured on the code before these
+changes (commit 4c0fa30: unfused callbacks too), so they show the whole gain; a rerun of ``before`` now
+measures the former methods with the fused callbacks. ``--profile N`` counts PETSc's vector operations and
+times our events per iteration for PK, BLMVM and BQNLS under displacement control at N, p* = 0.5 (the
+-log_view breakdown, read through petsc4py's log).
 
 FFT pairs (operator and preconditioner applications) are deterministic; wall times on the shared, loaded
 machine are not, so every ratio is from one run. Rows are kept in studies/output/tao_speed/tao_speed.json
@@ -60,10 +62,19 @@ TRIED = ["## Tried and not kept", "",
          "- lambda updated inside one TAO solve (in the convergence test): not built. The gradient's shift by a "
          "constant enters the L-BFGS pair that spans the update, and PETSc 3.18 gives no handle on BLMVM's "
          "L-BFGS matrix to reset it (TaoGetLMVMMatrix serves the BQNK types only); a restart costs one pair, so "
-         "the saving is bounded by the 2-7 inner solves.", ""]
+         "the saving is bounded by the 2-7 inner solves.",
+         "- The gap form's line searches (BLMVM, N = 512, p* = 0.5): armijo stopped on a failed line search at "
+         "a natural residual of 0.054, unit stagnated at 1, gpcg failed at once; More-Thuente (the default) "
+         "took 124 pairs.",
+         "- The gap form's compliance preconditioner for the Newton types (`-bound_pc fourier`, kept as an "
+         "option), N = 256, p* = 0.05 / 0.5 against none: TRON 173 / 148 pairs against 223 / 86, GPCG 2567 / 533 "
+         "against 245 / 106.",
+         "- The gap form's mean-mode weight (BLMVM, N = 256, p* = 0.5): 0.3 / 1 / 3 / 8 took 239 / 201 / 162 pairs "
+         "/ a failed line search; 3 is kept.", ""]
 
-# The options that select the former methods (variant "before").
-BEFORE = {"bound_load": "rootfind", "bound_h0": "none"}
+# The options of the variants other than "after" (-tao_type X as it is): "before", the methods before issue 40;
+# "al", load control by the augmented Lagrangian, the default before the gap form.
+VARIANT_OPTIONS = {"before": {"bound_load": "rootfind", "bound_h0": "none"}, "al": {"bound_load": "al"}}
 
 
 def problem_for(n):
@@ -80,8 +91,7 @@ def one_solve(problem, solver, variant, control, pstar, separation, max_time):
     options = {"solve_max_time": str(max_time)}
     if solver != "pk":
         options["tao_type"] = solver
-        if variant == "before":
-            options.update(BEFORE)
+        options.update(VARIANT_OPTIONS.get(variant, {}))
     load = {"pstar": pstar} if control == "load" else {"gbar": separation}
     result, _, seconds = common.solve(problem, options, 1e-8, control=control, **load)
     return {"iterations": result.iterations, "pairs": result.operator_applications,
@@ -109,8 +119,9 @@ def run_grid(args, path, rows):
             reference = [r for r in rows if (r["variant"], r["N"], r["pstar"], r["solver"], r["control"]) ==
                          ("after", n, pstar, "pk", "load")]
             plan = [("after", "pk", "load"), ("after", "pk", "displacement")]
+            # "al" differs from "after" under load control only: its displacement-controlled row is "after"'s.
             plan += [(variant, solver, control) for variant in args.variants for solver in args.solvers
-                     for control in ("load", "displacement")]
+                     for control in ("load", "displacement") if (variant, control) != ("al", "displacement")]
             for variant, solver, control in plan:
                 key = (variant, n, pstar, solver, control)
                 if key in done:
@@ -164,11 +175,12 @@ def grid_table(rows):
     header = ["N", "p*", "solver", "control", "variant", "its", "FFT pairs", "s", "ms/pair", "x PK time",
               "x PK ms/pair", "load/disp pairs", "natural", "load err", "reason"]
     lines = []
+    order = {"before": 0, "al": 1, "after": 2}
     for r in sorted(rows, key=lambda r: (r["N"], r["pstar"], r["solver"] != "pk", r["solver"], r["control"],
-                                         r["variant"] != "before")):
+                                         order[r["variant"]])):
         pk = find(rows, N=r["N"], pstar=r["pstar"], solver="pk", control=r["control"])
         disp = find(rows, N=r["N"], pstar=r["pstar"], solver=r["solver"], control="displacement",
-                    variant=r["variant"])
+                    variant="after" if r["variant"] == "al" else r["variant"])
         ratio = f"{r['pairs'] / disp['pairs']:.2f}" if r["control"] == "load" and disp else ""
         load_error = "" if r["load_error"] is None else f"{r['load_error']:.1e}"
         lines.append([r["N"], r["pstar"], r["solver"], r["control"], r["variant"], r["iterations"], r["pairs"],
@@ -212,9 +224,10 @@ def plot(rows, folder):
                              (pstar, solver, control, variant)), key=lambda r: r["N"])
             if not chosen:
                 continue
-            label = f"{solver} {control[:4]}" + (" (before)" if variant == "before" else "")
+            label = f"{solver} {control[:4]}" + ("" if variant == "after" else f" ({variant})")
             style = dict(color=colors[solver], marker="o" if control == "load" else "s",
-                         linestyle="-" if control == "load" else "--", fillstyle="full" if variant == "after" else "none")
+                         linestyle="--" if control == "displacement" else {"after": "-", "al": ":"}.get(variant, "-."),
+                         fillstyle="full" if variant == "after" else "none")
             n = [r["N"] for r in chosen]
             handles[label], = axes[0, column].plot(n, [r["pairs"] for r in chosen], label=label, **style)
             axes[1, column].plot(n, [r["seconds"] for r in chosen], label=label, **style)
@@ -231,19 +244,18 @@ def report(rows, profile, folder):
     lines = ["# TAO bound types against Polonsky-Keer, before and after issue 40", "",
              "Generated by `OPENBLAS_NUM_THREADS=1 .venv/bin/python studies/tao_speed.py --report` (group #1 "
              "surface, seed 1, natural KKT residual 1e-8, cold starts, FFTW_MEASURE plans from the wisdom cache). "
-             "FFT pairs are deterministic; seconds come from one run on a shared machine whose load average "
-             "was 2 to 13 on 2 cores across the runs, so every ratio is of one run. `x PK time`, `x PK ms/pair`: "
-             "against Polonsky-Keer under the same control, N and p*; `load/disp pairs`: the load-controlled solve's "
-             "pairs over the same solver's displacement-controlled ones. `before`: -tao_type X as it was (a "
-             "root find on d under load control, measured on the code before the change, commit 4c0fa30); `after`: `-tao_type X` as it is now (roughpetsc/solvers/bound_qp.py). "
-             "`before` was measured at N = 512, p* = 0.5 only (each root-find solve costs minutes at 1024); GPCG "
-             "under load control stalls after 1-2 inner solves at p* >= 0.5 (its projected search, as in the "
-             "residual floors of tao_floors.py) and was not rerun at N = 1024 (`--solvers blmvm bqnls tron`). "
-             "The `after` rows are of the penalty 0.1, unrecycled memory and inner tolerance 0.3 of the "
-             "quasi-Newton types, and of the inner-solve guard (an inner solve is done only after a step, and "
-             "the load error it may keep is capped at 1): PK, BLMVM and BQNLS from one run (`--solvers blmvm "
-             "bqnls`), TRON and GPCG from the next (`--solvers tron gpcg`, GPCG at N = 512 only), whose `x PK` "
-             "columns divide by the first run's PK.", ""] + TRIED
+             "FFT pairs are deterministic and include the certificate; seconds come from one run on a shared "
+             "two-core machine, so every ratio is of one run. `x PK time`, `x PK ms/pair`: against "
+             "Polonsky-Keer under the same control, N and p*; `load/disp pairs`: the load-controlled solve's pairs "
+             "over the same solver's displacement-controlled ones. Variants: `after`, `-tao_type X` as it is now "
+             "(under load control BLMVM, BQNLS, TRON and GPCG solve for the gap in one TAO solve, "
+             "roughpetsc/solvers/bound_gap.py; displacement control is unchanged); `al`, `-bound_load al`, the "
+             "augmented Lagrangian on mean(p) = pbar that was their load control before (bound_qp.py); `before`, "
+             "the methods before issue 40 (a root find on d, PETSc's initial Hessian), measured on commit 4c0fa30 "
+             "at N = 512, p* = 0.5 only. PK, `after` and `al` rows come from one run (`--variants after al "
+             "--solvers blmvm bqnls tron --max-time 200`, then `--variants after --solvers gpcg`); the `al` rows "
+             "of GPCG (stalls at p* >= 0.5 after 300 s) are from the run before, whose PK they divide by no longer.",
+             ""] + TRIED
     if rows:
         lines += ["## Every solve", "", grid_table(rows), "", f"![time and pairs]({plot(rows, folder)})", ""]
     if profile:
@@ -259,7 +271,7 @@ def main():
     parser.add_argument("--sizes", type=int, nargs="+", default=[512, 1024])
     parser.add_argument("--pstars", type=float, nargs="+", default=[0.05, 0.5, 2.0])
     parser.add_argument("--solvers", nargs="+", default=["blmvm", "bqnls", "gpcg", "tron"])
-    parser.add_argument("--variants", nargs="+", default=["after"], choices=["after", "before"])
+    parser.add_argument("--variants", nargs="+", default=["after"], choices=["after", "al", "before"])
     parser.add_argument("--max-time", type=float, default=600.0)
     parser.add_argument("--profile", type=int, default=0, help="N of the -log_view breakdown (0: none)")
     args, path, rows = common.start_resumable(parser, OUT, "tao_speed", "write tao_speed.md and the plot only")

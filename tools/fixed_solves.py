@@ -25,6 +25,7 @@ CASES = {
     "pk_displacement": SMALL + ["-gbar", "1e-4"],
     "root_find_blmvm": SMALL + ["-tao_type", "blmvm", "-pstar_list", "0.2,0.5"],
     "root_find_tron": SMALL + ["-tao_type", "tron", "-pstar", "0.5"],
+    "al_blmvm": SMALL + ["-tao_type", "blmvm", "-bound_load", "al", "-pstar_list", "0.2,0.5"],
     "bqnls_displacement": SMALL + ["-tao_type", "bqnls", "-gbar", "1e-4"],
     "almm": SMALL + ["-tao_type", "almm", "-pstar", "0.5", "-kkt_rtol", "1e-6"],
     "free_boundary": SMALL + ["-boundary", "free", "-pstar", "0.5"],

@@ -51,8 +51,12 @@ class FilterOperator:
     @log_event("RPCompliance")
     def displacement(self, pressure, out):
         """``out = K pressure``: the surface displacement, length units."""
+        self.compliance(self.local(pressure, readonly=True), self.local(out))
+
+    def compliance(self, source, target):
+        """``target = K source`` on local ``(rows, n1)`` arrays (may be the same array)."""
         self.applications += 1
-        self._filter(self.local(pressure, readonly=True), self.local(out), self.compliance_symbol)
+        self._filter(source, target, self.compliance_symbol)
 
     def _filter(self, source, target, symbol):
         self._filter_with(self.transform, source, target, symbol)

@@ -21,6 +21,7 @@ from ..contact import loops
 from ..errors import UserError
 from ..parallel import allmax, allsum
 from .bound_qp import AugmentedQuadratic, BoundQP, FourierInitialHessian, PenalizedCompliance, _set_recycle
+from .preconditioner import FourierPreconditioner
 from .protocol import Outcome
 from .stopping import ConvergenceTest, History, describe_stop, option_name
 
@@ -67,49 +68,51 @@ class GapHessian(_Stiffness, PenalizedCompliance):
     """MATPYTHON context: the Hessian S of Pi."""
 
 
-class GapInitialHessian(_Stiffness, FourierInitialHessian):
-    """The quasi-Newton types' initial Hessian in the gap: gamma K on the free set (zero mean there), the free
-    set's uniform mode by its stiffness, gamma / diag(S) off it."""
+class CompliancePreconditioner(FourierPreconditioner):
+    """The mirror of Polonsky-Keer's preconditioner for S on the free set F of the gap: K applied to the residual
+    made zero-mean on F, and F's uniform mode by its own stiffness 1_C' S 1_C / |F| (C the fixed nodes)."""
 
     mean_mode_weight = GAP_MEAN_MODE_WEIGHT
 
-    def __init__(self, problem, objective):
-        super().__init__(problem, objective)
-        self.fixed_scale = 1.0 / problem.operator.stiffness_diagonal
-        self.indicator, self.response = problem.vec(), problem.vec()
-        self._mean_mode = (0.0, 1.0)  # (|F| it was computed for, its compliance)
-        grid = problem.scaled_grid
-        self.longest_compliance = max(grid.l0, grid.l1) / np.pi
+    def inverse_symbol(self, source, target):
+        self.problem.operator.compliance(source, target)
 
-    def _inverse_on_free(self, residual, out):
-        self.problem.operator.displacement(residual, out)
-
-    def _mean_mode_curvature(self, count):
-        """1_C' S 1_C / |F|, the stiffness of the uniform gap on the free set F (C the fixed nodes): recomputed,
-        one operator application, when |F| changed by more than 5 %; without fixed nodes, that of the longest
-        wavelength."""
+    def mean_mode_compliance(self, free, count):
+        """The stiffness of the uniform gap on F (the divisor of its mean): recomputed, one operator application,
+        when |F| changed by more than 5 %; without fixed nodes, that of the longest wavelength."""
         computed_for, stiffness = self._mean_mode
         if abs(count - computed_for) <= 0.05 * count:
             return stiffness
         problem = self.problem
         fixed = problem.local(self.indicator).ravel()
-        np.subtract(1.0, self.mask, out=fixed)
+        np.subtract(1.0, free, out=fixed)
         problem.operator.elastic_pressure(self.indicator, self.response)
         energy, = allsum(problem.mpi, [np.dot(problem.local(self.response, readonly=True).ravel(), fixed)])
-        stiffness = energy / count if energy > 0 else 1.0 / self.longest_compliance
+        grid = problem.scaled_grid
+        stiffness = energy / count if energy > 0 else np.pi / max(grid.l0, grid.l1)
         self._mean_mode = (count, stiffness)
         return stiffness
 
-    def destroy(self, mat=None):
-        super().destroy(mat)
-        self.indicator.destroy()
-        self.response.destroy()
+
+class GapInitialHessian(_Stiffness, FourierInitialHessian):
+    """The quasi-Newton types' initial Hessian in the gap: gamma times :class:`CompliancePreconditioner` on the
+    free set, gamma / diag(S) off it."""
+
+    mean_mode_weight, mean_mode_type = GAP_MEAN_MODE_WEIGHT, CompliancePreconditioner
+
+    def __init__(self, problem, objective):
+        super().__init__(problem, objective)
+        self.fixed_scale = 1.0 / problem.operator.stiffness_diagonal
+
+    def _inverse_on_free(self, residual, out):
+        self.problem.operator.displacement(residual, out)
 
 
 class GapLoadQP(BoundQP):
     """A bound-constrained TAO type under load control, solved for the gap (module docstring)."""
 
     objective_type, hessian_type, initial_hessian_type = GapQuadratic, GapHessian, GapInitialHessian
+    preconditioner_type = CompliancePreconditioner
 
     def __init__(self, problem, control, tao_type, settings):
         name = option_name("bound_load", settings.prefix)
@@ -128,12 +131,6 @@ class GapLoadQP(BoundQP):
     @staticmethod
     def _default_preconditioner(tao_type):
         return "none"
-
-    def _check_options(self, h0, preconditioner):
-        super()._check_options(h0, preconditioner)
-        if preconditioner == "fourier":
-            raise UserError(f"{option_name('bound_pc', self.prefix)} fourier preconditions the pressure's QP; "
-                            f"with {option_name('bound_load', self.prefix)} gap use none or options")
 
     def _natural_residual(self, tao):
         """``(natural, load error, fresh)`` of the pressure the iterate would report, on its own fresh gap.

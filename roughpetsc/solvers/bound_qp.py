@@ -212,6 +212,7 @@ class FourierInitialHessian(PenalizedCompliance):
     gamma times Polonsky-Keer's approximation of its inverse on the current free set (docs/solvers.md)."""
 
     mean_mode_weight = MEAN_MODE_WEIGHT
+    mean_mode_type = PenalizedFourier
 
     def __init__(self, problem, objective):
         super().__init__(problem)
@@ -219,7 +220,7 @@ class FourierInitialHessian(PenalizedCompliance):
         self.gamma = 1.0
         self.mask = np.zeros(int(np.prod(problem.operator.local_shape)))  # 1.0 on the free set
         self.residual = problem.vec()
-        self.fourier = PenalizedFourier(problem)
+        self.fourier = self.mean_mode_type(problem)
         self.fixed_scale = 1.0 / problem.operator.diagonal
         grid = problem.scaled_grid
         self.longest_compliance = max(grid.l0, grid.l1) / np.pi
@@ -369,6 +370,7 @@ class BoundQP(Backend):
     """A bound-constrained TAO type under load (augmented Lagrangian) or displacement control."""
 
     objective_type, hessian_type, initial_hessian_type = AugmentedQuadratic, PenalizedCompliance, FourierInitialHessian
+    preconditioner_type = FourierPreconditioner
 
     def __init__(self, problem, control, tao_type, settings):
         self.problem = problem
@@ -403,7 +405,7 @@ class BoundQP(Backend):
         tao.setOptionsPrefix(settings.prefix)
         tao.setType(tao_type)
         if tao_type in KSP_TYPES and preconditioner == "fourier":
-            self.fourier = FourierPreconditioner(problem)
+            self.fourier = self.preconditioner_type(problem)
             self.preconditioning = self.fourier.mat()
             tao.getKSP().getPC().setType("mat")
         elif tao_type in KSP_TYPES and preconditioner == "none":

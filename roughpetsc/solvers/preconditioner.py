@@ -20,6 +20,8 @@ MEAN_MODE_WEIGHT = 8.0
 class FourierPreconditioner:
     """``B`` of the module docstring for a :class:`~roughpetsc.contact.ContactProblem`."""
 
+    mean_mode_weight = MEAN_MODE_WEIGHT
+
     def __init__(self, problem):
         self.problem = problem
         self.indicator = problem.vec()
@@ -55,20 +57,24 @@ class FourierPreconditioner:
         operator = problem.operator
         shape = operator.local_shape
         if keep_load:  # P residual = residual
-            operator.stiffness(residual.reshape(shape), out.reshape(shape))
+            self.inverse_symbol(residual.reshape(shape), out.reshape(shape))
         else:
             residual_sum, = allsum(problem.mpi, [residual.sum()])
             residual_mean = residual_sum / count
             np.multiply(contact, -residual_mean, out=out)
             out += residual  # P residual, built in out: the FFT pair may run in place
-            operator.stiffness(out.reshape(shape), out.reshape(shape))
+            self.inverse_symbol(out.reshape(shape), out.reshape(shape))
         out_sum, = allsum(problem.mpi, [loops.masked_sum(out, contact)])
         loops.shift_on(out, contact, out_sum / count, out)
         if not keep_load:
             compliance = self.mean_mode_compliance(contact, count)
             if not np.isfinite(compliance):
                 compliance = rigid_compliance
-            out += MEAN_MODE_WEIGHT * residual_mean / compliance * contact
+            out += self.mean_mode_weight * residual_mean / compliance * contact
+
+    def inverse_symbol(self, source, target):
+        """The approximate inverse of the Hessian on local ``(rows, n1)`` arrays: here the stiffness S."""
+        self.problem.operator.stiffness(source, target)
 
     def mat(self):
         """A python Mat applying ``B`` with C = all nodes (``createSubMatrix``: on a free set), for PC type ``mat``."""
