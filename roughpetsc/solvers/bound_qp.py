@@ -33,9 +33,8 @@ BOUND_PRECONDITIONERS = ("fourier", "none", "options")
 INITIAL_HESSIANS = ("fourier", "none")
 LOAD_METHODS = ("al", "rootfind", "gap")
 # The types whose load control is in the gap by default where it applies: against the augmented Lagrangian it
-# took 0.31-0.64x the FFT pairs of BLMVM, BQNLS and TRON at N = 512 and 1024, p* = 0.05-2 (group #1), and
-# 0.99x of TRON at p* = 0.05; GPCG converged at p* = 0.5 and 2, where it stalls with the multiplier (at
-# p* = 0.05 on 512^2 it ran out of 200 s, which the multiplier did not).
+# took 0.43-0.81x the FFT pairs of BLMVM and BQNLS and 0.10-0.84x of TRON at N = 512 and 1024, p* = 0.05-2
+# (group #1); GPCG converged at p* = 0.5 and 2, where it stalls with the multiplier, except at N = 1024, p* = 2.
 GAP_DEFAULT_TYPES = ("blmvm", "bqnls", "tron", "gpcg")
 # Bounds of the initial Hessian's scale gamma; it settled at 0.1-0.3 in the solves measured.
 GAMMA_BOUNDS = (1e-3, 1e3)
