@@ -117,6 +117,7 @@ class GapLoadQP(BoundQP):
 
     objective_type, hessian_type, initial_hessian_type = GapQuadratic, GapHessian, GapInitialHessian
     preconditioner_type = CompliancePreconditioner
+    load_method = "gap"
 
     def __init__(self, problem, control, tao_type, settings):
         name = option_name("bound_load", settings.prefix)

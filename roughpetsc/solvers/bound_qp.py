@@ -7,6 +7,7 @@ docs/solvers.md, "The bound-constrained TAO types".
 
 import ctypes
 import math
+import re
 
 import numpy as np
 from petsc4py import PETSc
@@ -15,7 +16,7 @@ from ..contact import loops
 from ..elastic.operator import ShellContext
 from ..errors import UserError
 from ..parallel import allmax, allmin, allsum
-from .options import _petsc_library, default_options, set_from_options
+from .options import _petsc_library, default_options, given_but_unusable, set_from_options
 from .preconditioner import MEAN_MODE_WEIGHT, FourierPreconditioner
 from .protocol import Backend, Outcome
 from .registry import register
@@ -368,6 +369,8 @@ def next_multiplier(points, pbar, separation, stiffness=None, touch=None):
 class BoundQP(Backend):
     """A bound-constrained TAO type under load (augmented Lagrangian) or displacement control."""
 
+    load_method = "al"
+
     objective_type, hessian_type, initial_hessian_type = AugmentedQuadratic, PenalizedCompliance, FourierInitialHessian
     preconditioner_type = FourierPreconditioner
 
@@ -457,6 +460,21 @@ class BoundQP(Backend):
             raise UserError(f"{option_name('bound_al_eta', prefix)} must be in [0, 1), got {self.eta}")
         if self.max_outer < 1:
             raise UserError(f"{option_name('bound_al_max_outer', prefix)} must be at least 1, got {self.max_outer}")
+
+    def unusable_options(self):
+        """This backend's own options given for a part it does not run: the load control's under displacement
+        control (or the augmented Lagrangian's beside another method), the initial Hessian of a type without
+        L-BFGS, the preconditioner of a type without a KSP. Reported like unused options."""
+        names = []
+        if self.control == "displacement":
+            names += ["bound_load", "bound_al_"]
+        elif self.load_method != "al":
+            names += ["bound_al_"]
+        if self.tao.getType() not in QUASI_NEWTON_TYPES:
+            names.append("bound_h0")
+        if self.tao.getType() not in KSP_TYPES:
+            names.append("bound_pc")
+        return given_but_unusable(re.compile("^(" + "|".join(names) + ")"), self.prefix) if names else []
 
     def _evaluate_hessian(self, tao, x, H, P):
         self.hessian_context.perturbation = 0.0  # a fresh Hessian: BNK's MatShift of the last one is undone

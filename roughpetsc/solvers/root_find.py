@@ -38,6 +38,10 @@ class RootFind(Backend):
     def tao(self):
         return self.qp.tao
 
+    def unusable_options(self):
+        """Those of the displacement-controlled solver it drives, but -bound_load, which chose this method."""
+        return [name for name in self.qp.unusable_options() if not name.endswith("bound_load")]
+
     def solve(self, pbar, pressure, guess):
         """Solve for the mean pressure ``pbar`` (scaled); ``guess.separation`` is tried first if inside the bracket."""
         from scipy.optimize import brentq

@@ -58,6 +58,27 @@ def test_an_unreadable_solver_option_is_refused_by_name(tmp_path, args, named):
     assert out.stdout == "" and not list(tmp_path.iterdir()), message
 
 
+# A bound type's own option for a part that run does not have: read, then never used (all were accepted before).
+@pytest.mark.parametrize("args, named", [
+    (["-tao_type", "blmvm", "-bound_load", "gap", "-gbar", "1e-4"], "-bound_load"),  # displacement control
+    (["-tao_type", "blmvm", "-bound_al_penalty", "1"], "-bound_al_penalty"),         # the gap form has no multiplier
+    (["-tao_type", "blmvm", "-bound_load", "rootfind", "-bound_al_eta", "0.2"], "-bound_al_eta"),
+    (["-tao_type", "tron", "-bound_h0", "fourier"], "-bound_h0"),                    # no L-BFGS in TRON
+    (["-tao_type", "blmvm", "-bound_pc", "fourier"], "-bound_pc"),                   # no KSP in BLMVM
+])
+def test_a_bound_option_for_a_part_the_run_lacks_is_refused(tmp_path, args, named):
+    out = run_cli(TINY + args + ["-json", "s.json"], cwd=tmp_path)
+    message = assert_one_clear_error(out, named, "not used")
+    assert not list(tmp_path.iterdir()), message
+
+
+def test_the_augmented_lagrangian_takes_its_options(tmp_path):
+    out = run_cli(TINY + ["-tao_type", "blmvm", "-bound_load", "al", "-bound_al_penalty", "1", "-json", "s.json"],
+                  cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert json.load(open(tmp_path / "s.json"))["steps"][0]["solver"] == "blmvm(al)"
+
+
 @pytest.mark.parametrize("switch", [["-quiet"], ["-quiet", "1"], ["-quiet", "true"], ["-overwrite", "-quiet"]])
 def test_switches_stand_alone(tmp_path, switch):
     out = run_cli(TINY + switch + ["-json", tmp_path / "s.json"])
