@@ -70,7 +70,9 @@ TRIED = ["## Tried and not kept", "",
          "option), N = 256, p* = 0.05 / 0.5 against none: TRON 173 / 148 pairs against 223 / 86, GPCG 2567 / 533 "
          "against 245 / 106.",
          "- The gap form's mean-mode weight (BLMVM, N = 256, p* = 0.5): 0.3 / 1 / 3 / 8 took 239 / 201 / 162 pairs "
-         "/ a failed line search; 3 is kept.", ""]
+         "/ a failed line search; 3 is kept.",
+         "- The gap form's L-BFGS memory (N = 512, p* = 0.05 / 0.5 / 2): BLMVM 95 / 114 / 54 pairs at 1 (kept), "
+         "115 / 124 / 177 at 3, 126 / 128 / 870 at 5; BQNLS 109 / 120 / 49 at 1, 128 / 141 / 75 at 10.", ""]
 
 # The options of the variants other than "after" (-tao_type X as it is): "before", the methods before issue 40;
 # "al", load control by the augmented Lagrangian, the default before the gap form.
