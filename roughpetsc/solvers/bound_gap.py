@@ -109,9 +109,6 @@ class GapInitialHessian(_Stiffness, FourierInitialHessian):
         super().__init__(problem, objective)
         self.fixed_scale = 1.0 / problem.operator.stiffness_diagonal
 
-    def _inverse_on_free(self, residual, out):
-        self.problem.operator.displacement(residual, out)
-
 
 class GapLoadQP(BoundQP):
     """A bound-constrained TAO type under load control, solved for the gap (module docstring)."""

@@ -257,8 +257,7 @@ class FourierInitialHessian(PenalizedCompliance):
 
     def _inverse_on_free(self, residual, out):
         """``out`` = the approximate inverse of the Hessian applied to ``residual`` (zero mean on the free set)."""
-        shape = self.problem.operator.local_shape
-        self.problem.operator.stiffness(residual.getArray(readonly=True).reshape(shape), out.getArray().reshape(shape))
+        self.fourier.inverse_symbol(self.problem.local(residual, readonly=True), self.problem.local(out))
 
     def _mean_mode_curvature(self, count):
         """The Hessian's curvature on the uniform field of the free set (``mask``, ``count`` nodes): its compliance."""
