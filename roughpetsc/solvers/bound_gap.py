@@ -8,8 +8,8 @@ the pressure is p = pbar + S (g + h). The gap g >= 0 that minimises
 has the gradient p, so the KKT conditions of Pi are those of the contact problem (3.41)-(3.44): g >= 0, p >= 0,
 g p = 0, and mean(p) = pbar holds at every iterate. Its Hessian is S. :class:`CompliancePreconditioner`, the
 compliance K on the free set (the mirror of Polonsky-Keer's S on the contact set), starts the quasi-Newton
-types' L-BFGS, and preconditions the Newton types' KSP with ``-bound_pc fourier`` (their default is none, which
-measured better at p* = 0.5; docs/solvers.md). This works on the periodic boundary
+types' L-BFGS, and preconditions the Newton types' KSP with ``-bound_pc fourier`` (TRON's default; the others'
+is none, which measured better; docs/solvers.md). This works on the periodic boundary
 without a hardness cap only: the free boundary's stiffness is no Fourier filter, and a cap bounds p, which is
 the gradient here, not the unknown. See docs/solvers.md.
 """
@@ -33,6 +33,11 @@ GAP_MEAN_MODE_WEIGHT = 3.0
 # The reported pressure's residual is measured at each new lowest residual of the iterate below this multiple of
 # the tolerance (GapLoadQP._natural_residual).
 CHECK_ABOVE = 10.0
+# The Newton types that take the compliance preconditioner by default here. TRON (KSP at 0.1) took 165 / 142 / 70
+# FFT pairs with it against 206 / 95 / 53 without at N = 512, 158 / 158 / 75 against 283 / 122 / 71 at 1024
+# (group #1, p* = 0.05 / 0.5 / 2): fewer at the small load, where it was slowest. BNTR (292 / 244 / 121 against
+# 427 / 161 / 91 at 512) and GPCG (2567 / 533 against 245 / 106 at 256, p* = 0.05 / 0.5) keep none.
+GAP_FOURIER_DEFAULT_TYPES = ("tron",)
 
 
 class GapQuadratic(AugmentedQuadratic):
@@ -133,7 +138,7 @@ class GapLoadQP(BoundQP):
 
     @staticmethod
     def _default_preconditioner(tao_type):
-        return "none"
+        return "fourier" if tao_type in GAP_FOURIER_DEFAULT_TYPES else "none"
 
     @PETSc.Log.EventDecorator("RPBoundTest")  # -log_view: the fused convergence test
     def _natural_residual(self, tao):
