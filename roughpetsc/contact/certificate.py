@@ -93,15 +93,16 @@ def certified(reason, kkt, rtol, load_name="load error", gradient="gap"):
     """``(converged, reason)`` of a result whose certificate, on a fresh ``gradient``, is ``kkt``.
 
     Converged: the natural residual and the load error are at most ``rtol``; the solver's ``reason`` stands.
-    Otherwise the reason quotes the certificate (which the files record) in place of the solver's own best
-    residual, and a reason whose solver's own test passed becomes ``NOT_CERTIFIED``.
+    Otherwise a reason whose solver's own test passed becomes ``NOT_CERTIFIED``. Either way the reason quotes
+    the certificate (which the files record) in place of the solver's own best residual: a stop on the time
+    limit whose best iterate passes said "best ... 3.7e-07" beside a certified 6.2e-10.
     """
-    if kkt.natural <= rtol and (kkt.load_error is None or kkt.load_error <= rtol):
-        return True, reason
     measured = f"natural residual {kkt.natural:.2g}"
     if kkt.load_error is not None:
         measured += f", {load_name} {kkt.load_error:.2g}"
     reason = BEST_NOTE.sub(measured, reason, count=1)
+    if kkt.natural <= rtol and (kkt.load_error is None or kkt.load_error <= rtol):
+        return True, reason
     if reason.startswith(("CONVERGED", "COMPLETE")):
         reason = f"NOT_CERTIFIED ({reason}, but on a fresh {gradient}: {measured})"
     return False, reason
