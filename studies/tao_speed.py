@@ -72,7 +72,18 @@ TRIED = ["## Tried and not kept", "",
          "- The gap form's mean-mode weight (BLMVM, N = 256, p* = 0.5): 0.3 / 1 / 3 / 8 took 239 / 201 / 162 pairs "
          "/ a failed line search; 3 is kept.",
          "- The gap form's L-BFGS memory (N = 512, p* = 0.05 / 0.5 / 2): BLMVM 95 / 114 / 54 pairs at 1 (kept), "
-         "115 / 124 / 177 at 3, 126 / 128 / 870 at 5; BQNLS 109 / 120 / 49 at 1, 128 / 141 / 75 at 10.", ""]
+         "115 / 124 / 177 at 3, 126 / 128 / 870 at 5; BQNLS 109 / 120 / 49 at 1, 128 / 141 / 75 at 10.",
+         "- The gap form's mean-mode weight at small loads, from the highest summit (BLMVM, N = 256, p* = 0.01 / "
+         "0.05 / 0.5): 1022 / 98 / 121 pairs at 3, 419 / 127 / 153 at 0.3, 127 / 202 / 266 at 0.03; no weight "
+         "served every load, and the cut start (64 / 65 / 95) replaced the search for one.",
+         "- TRON's KSP tolerance in the gap form without a preconditioner (N = 512, p* = 0.05 / 0.5 / 2): 217 / "
+         "97 / 60 pairs at 0.3, 206 / 95 / 53 at 0.1, 228 / 87 / 52 at 0.03, 379 / 127 / 55 at PETSc's 1e-5; "
+         "with the compliance preconditioner 175 / 148 / 79 at 0.3, 165 / 142 / 70 at 0.1 (kept); at most 10 "
+         "gradient-projection steps (`-tao_tron_maxgpits`, default 3) 212 / 142 / 74.",
+         "- GPCG's KSP tolerance in the gap form (N = 512, p* = 0.05 / 0.5 / 2): 1e-3 stalled at a natural "
+         "residual of 1.6e-7 / 1.3e-6 / 3.1e-8 with its iterate unchanged for 100 s; 1e-2 gave 329 / 90 / 69 "
+         "pairs (before the cut start, 0.1 and 1e-2 stalled at three and two of the loads). PETSc's 1e-5 is "
+         "kept.", ""]
 
 # The options of the variants other than "after" (-tao_type X as it is): "before", the methods before issue 40;
 # "al", load control by the augmented Lagrangian, the default before the gap form.
@@ -262,18 +273,20 @@ def report(rows, profile, folder):
              "roughpetsc/solvers/bound_gap.py; displacement control is unchanged); `al`, `-bound_load al`, the "
              "augmented Lagrangian on mean(p) = pbar that was their load control before (bound_qp.py); `before`, "
              "the methods before issue 40 (a root find on d, PETSc's initial Hessian), measured on commit 4c0fa30 "
-             "at N = 512, p* = 0.5 only. PK, `after` and `al` rows come from one run (`--variants after al "
-             "--solvers blmvm bqnls tron --max-time 200`, then `--variants after --solvers gpcg`); the `al` rows "
-             "of GPCG (stalls at p* >= 0.5 after 300 s) are from the run before, whose PK they divide by no longer.",
+             "at N = 512, p* = 0.5 only. PK and `after` rows come from one run (`--variants after --max-time 200`, "
+             "beside the stress grid and a niced BEM run), after the gap form's cold start from the cut surface "
+             "and TRON's preconditioned inexact Newton steps; the `al` rows (`--variants al --solvers blmvm bqnls "
+             "tron --max-time 200`; GPCG's, which stall at p* >= 0.5 after 300 s, from the run before) are from "
+             "earlier runs, whose PK they divide by no longer.",
              ""] + TRIED
     if rows:
         lines += ["## Every solve", "", grid_table(rows), "", f"![time and pairs]({plot(rows, folder)})", ""]
     if profile:
         lines += [f"## Where the time goes: N = {profile[0]['N']}, p* = 0.5", "",
                   "Vector operations per iteration by PETSc event (-log_view counts read through petsc4py), "
-                  "and seconds in them, in FFT pairs and in our callbacks. The load-controlled rows (the gap "
-                  "form of BLMVM and BQNLS) were added in a later run, beside a background BEM run: their "
-                  "seconds are not comparable with the others', their counts are.", "", profile_table(profile), ""]
+                  "and seconds in them, in FFT pairs and in our callbacks. The `after` rows come from one run "
+                  "(`--profile 1024`), beside the stress grid and a niced BEM run; the `before` rows from an "
+                  "earlier one.", "", profile_table(profile), ""]
     with open(os.path.join(folder, "tao_speed.md"), "w") as f:
         f.write("\n".join(lines))
 
