@@ -125,6 +125,7 @@ class GapLoadQP(BoundQP):
     objective_type, hessian_type, initial_hessian_type = GapQuadratic, GapHessian, GapInitialHessian
     preconditioner_type = CompliancePreconditioner
     load_method = "gap"
+    keeps_displacement = True  # the load path's K p of the start spares the start's operator application
 
     def __init__(self, problem, control, tao_type, settings):
         name = option_name("bound_load", settings.prefix)
@@ -224,7 +225,8 @@ class GapLoadQP(BoundQP):
         """Solve for the mean pressure ``target`` from ``pressure`` (overwritten with the solution).
 
         The start is the gap of ``pressure`` at the guessed separation (without one, :meth:`_cold_separation`),
-        clipped at zero: one operator application.
+        clipped at zero: one operator application, none where the load path's predictor gives K p of ``pressure``
+        (``guess.displacement``).
         """
         problem = self.problem
         history = history or History(problem)
@@ -237,7 +239,11 @@ class GapLoadQP(BoundQP):
         separation = guess.separation if guess is not None and guess.separation is not None else None
         if separation is None:
             separation = self._cold_separation(target)
-        problem.gap(pressure, separation, gap)
+        if guess is not None and guess.displacement is not None:
+            gap.waxpy(-1.0, problem.heights, guess.displacement)
+            gap.shift(separation)
+        else:
+            problem.gap(pressure, separation, gap)
         np.maximum(problem.local(gap), 0.0, out=problem.local(gap))
         _set_recycle(self.tao, False)
         iterations, restarts = self._run(gap, test)
