@@ -83,9 +83,11 @@ SOLVER_HELP = """Solvers (PETSc options):
   (no -tao_type)          Polonsky-Keer projected CG (TAO type python) with the bound-constrained active set
                           (-pk_active_set bccg), preconditioned by the inverse Westergaard symbol (-pk_pc fourier);
                           load control (-pstar/-pbar) or displacement control (-gbar)
-  -tao_type <bound type>  blmvm bqnls bncg bqnkls bqnktr bnls bntr tron gpcg: displacement control directly,
-                          load control by an augmented Lagrangian on the mean pressure inside the solve
-                          (-bound_load al), or a safeguarded root find on the mean gap (-bound_load rootfind)
+  -tao_type <bound type>  blmvm bqnls bncg bqnkls bqnktr bnls bntr tron gpcg: displacement control directly;
+                          load control in the gap, whose gradient is the pressure of the load (-bound_load gap;
+                          every type but bncg on the periodic cell without -hardness), by an augmented Lagrangian
+                          on the mean pressure inside the solve (-bound_load al; bncg, and where the gap form
+                          does not apply), or a safeguarded root find on the mean gap (-bound_load rootfind)
   -tao_type almm          load control by TAO ALMM (-tao_almm_subsolver_tao_type bqnls|blmvm|...)
   with -adhesion          the projected CG on the gap (no -tao_type, or gapcg), or -tao_type almm with the
                           mean-gap equality; displacement control (-gbar, -gbar_list)

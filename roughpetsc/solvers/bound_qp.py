@@ -39,8 +39,11 @@ LOAD_METHODS = ("al", "rootfind", "gap")
 # took 0.43-0.81x the FFT pairs of BLMVM and BQNLS and 0.10-0.84x of TRON at N = 512 and 1024, p* = 0.05-2
 # (group #1); GPCG converged at p* = 0.5 and 2, where it stalls with the multiplier, except at N = 1024, p* = 2;
 # BNTR took 427 / 161 / 91 pairs (292 / 244 / 121 with -bound_pc fourier) against 516 / 605 / 209 at N = 512.
-# Not BNCG (out of 60 s at p* = 0.05 and 0.5), nor BQNKLS, BQNKTR, BNLS (better at one or two loads of three).
-GAP_DEFAULT_TYPES = ("blmvm", "bqnls", "tron", "gpcg", "bntr")
+# From the cut start (N = 512, p* = 0.05 / 0.5 / 2), the gap against the multiplier: BQNKLS 292 / 252 / 130 pairs
+# against 541 / 600 / 206, BQNKTR 256 / 262 / 138 against 582 / 626 / 220, BQNKTL 256 / 262 / 138 against
+# 582 / 626 / 220, BNLS 361 / 139 / 78 against 568 / 488 / 163, BNTL 294 / 143 at p* = 0.05 / 0.5 against 520 / 516.
+# Not BNCG: out of 60 s at p* = 0.05 and 0.5 in the gap (natural residual 1.2e-4), against 128 / 216 / 235 pairs.
+GAP_DEFAULT_TYPES = ("blmvm", "bqnls", "bqnkls", "bqnktr", "bqnktl", "bnls", "bntr", "bntl", "tron", "gpcg")
 # Bounds of the initial Hessian's scale gamma; it settled at 0.1-0.3 in the solves measured.
 GAMMA_BOUNDS = (1e-3, 1e3)
 # The default penalty c of the augmented Lagrangian (units of L / pi): with the Fourier H0, BLMVM and BQNLS took
@@ -64,8 +67,8 @@ OPTIONS = [
     ("bound_h0", "", "TAO blmvm/bqnls/bqnk*: initial Hessian of L-BFGS: fourier (Polonsky-Keer's preconditioner on "
                      "the free set, their default) | none (PETSc's)"),
     ("bound_load", "", "TAO bound types under load control: gap (one solve for the gap, whose gradient is the "
-                       "pressure of mean pbar; periodic boundary without a hardness cap; default of blmvm, bqnls, "
-                       "tron, gpcg, bntr there) | al (augmented Lagrangian on mean(p) = pbar inside the solve; default "
+                       "pressure of mean pbar; periodic boundary without a hardness cap; default of every type but "
+                       "bncg there) | al (augmented Lagrangian on mean(p) = pbar inside the solve; default "
                        "otherwise) | rootfind (a safeguarded root find on the separation around displacement "
                        "control)"),
     ("bound_al_penalty", "", "augmented Lagrangian: penalty c in units of the compliance of the longest wavelength "
