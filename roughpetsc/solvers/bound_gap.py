@@ -36,7 +36,9 @@ CHECK_ABOVE = 10.0
 # The Newton types that take the compliance preconditioner by default here. TRON (KSP at 0.1) took 165 / 142 / 70
 # FFT pairs with it against 206 / 95 / 53 without at N = 512, 158 / 158 / 75 against 283 / 122 / 71 at 1024
 # (group #1, p* = 0.05 / 0.5 / 2): fewer at the small load, where it was slowest. BNTR (292 / 244 / 121 against
-# 427 / 161 / 91 at 512) and GPCG (2567 / 533 against 245 / 106 at 256, p* = 0.05 / 0.5) keep none.
+# 427 / 161 / 91 at 512) and GPCG keep none: GPCG, preconditioned on its free set (FreeSetPC), ran out of 100 s
+# at a natural residual of 5.2e-10 / 1.2e-6 at N = 512, p* = 0.05 / 0.5 (301 / 146 pairs without), its line
+# search's floor (docs/solvers.md), and took 103 pairs against 78 at p* = 2.
 GAP_FOURIER_DEFAULT_TYPES = ("tron",)
 # The cold start's bisection on the separation (GapLoadQP._cold_separation) stops once the free nodes' mean
 # pressure is within this fraction of pbar, or after START_STEPS operator applications.
