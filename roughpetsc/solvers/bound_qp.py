@@ -27,12 +27,13 @@ BOUND_TYPES = ("blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bqnktl", "bnls", "
 # Types whose Newton step is a KSP solve on the free set: they take the Fourier preconditioner. It is their
 # default where it won (group #1, N = 512, p* = 0.5, displacement control: BNLS 622 -> 495 operator
 # applications). GPCG's goes through FreeSetPC (PETSc's GPCG ignores the preconditioning matrix; through it, it
-# took 434 -> 6520): 161 / 330 / 260 pairs against 155 / 432 / 650 without at N = 512, p* = 0.05 / 0.5 / 2
-# (displacement control). TRON with its KSP at 0.1 took 127 / 191 / 178 pairs
+# took 434 -> 6520): under displacement control 161 / 330 / 260 pairs against 155 / 432 / 650 without at N = 512,
+# 217 / 413 / 334 against 250 / 672 / 1027 at 1024 (p* = 0.05 / 0.5 / 2); under the augmented Lagrangian 398
+# against 377 at N = 512, p* = 0.05, and the same stall at 0.5 and 2. TRON with its KSP at 0.1 took 127 / 191 / 178 pairs
 # with it against 116 / 192 / 432 without at N = 512, 137 / 201 / 196 against 144 / 245 / 467 at 1024
 # (p* = 0.05 / 0.5 / 2).
 KSP_TYPES = ("bnls", "bntr", "bntl", "tron", "gpcg")
-FOURIER_DEFAULT_TYPES = ("bnls", "bntr", "bntl", "tron")
+FOURIER_DEFAULT_TYPES = ("bnls", "bntr", "bntl", "tron", "gpcg")
 QUASI_NEWTON_TYPES = ("blmvm", "bqnls", "bqnkls", "bqnktr", "bqnktl")
 BOUND_PRECONDITIONERS = ("fourier", "none", "options")
 INITIAL_HESSIANS = ("fourier", "none")
@@ -63,8 +64,8 @@ MAX_RESTARTS = 8
 RESTART_GAIN = 0.9
 
 OPTIONS = [
-    ("bound_pc", "", "TAO bnls/bntr/bntl/tron/gpcg: fourier (inverse symbol on the free set; default of the BNK "
-                     "types and tron; of tron alone in the gap form) | none (the others' default) | options "
+    ("bound_pc", "", "TAO bnls/bntr/bntl/tron/gpcg: fourier (inverse symbol on the free set; their default, but "
+                     "of tron alone in the gap form) | none (the others' default in the gap form) | options "
                      "(-tao_*pc_type decides)"),
     ("bound_h0", "", "TAO blmvm/bqnls/bqnk*: initial Hessian of L-BFGS: fourier (Polonsky-Keer's preconditioner on "
                      "the free set, their default) | none (PETSc's)"),
