@@ -44,7 +44,7 @@ LOAD_METHODS = ("al", "rootfind", "gap")
 # BNTR took 427 / 161 / 91 pairs (292 / 244 / 121 with -bound_pc fourier) against 516 / 605 / 209 at N = 512.
 # From the cut start (N = 512, p* = 0.05 / 0.5 / 2), the gap against the multiplier: BQNKLS 292 / 252 / 130 pairs
 # against 541 / 600 / 206, BQNKTR 256 / 262 / 138 against 582 / 626 / 220, BQNKTL 256 / 262 / 138 against
-# 582 / 626 / 220, BNLS 361 / 139 / 78 against 568 / 488 / 163, BNTL 294 / 143 at p* = 0.05 / 0.5 against 520 / 516.
+# 582 / 626 / 220, BNLS 361 / 139 / 78 against 568 / 488 / 163, BNTL 294 / 143 / 97 against 520 / 516 / 209.
 # Not BNCG: out of 60 s at p* = 0.05 and 0.5 in the gap (natural residual 1.2e-4), against 128 / 216 / 235 pairs.
 GAP_DEFAULT_TYPES = ("blmvm", "bqnls", "bqnkls", "bqnktr", "bqnktl", "bnls", "bntr", "bntl", "tron", "gpcg")
 # Bounds of the initial Hessian's scale gamma; it settled at 0.1-0.3 in the solves measured.
