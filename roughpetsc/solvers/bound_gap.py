@@ -138,8 +138,9 @@ class GapLoadQP(BoundQP):
             raise UserError(f"{where} needs the periodic boundary without a hardness cap (the free boundary's "
                             f"stiffness is no Fourier filter; a cap bounds the pressure, which is the gradient "
                             f"there): use {name} al")
-        super().__init__(problem, control, tao_type, settings)
+        # Before the base's set-up, whose refusal of a bad TAO option calls destroy.
         self.variable, self.reported = problem.vec(), problem.vec()
+        super().__init__(problem, control, tao_type, settings)
         self.lowest = math.inf
         self.name = self.tao.getType() + "(gap)"
 
