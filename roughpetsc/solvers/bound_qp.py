@@ -29,9 +29,9 @@ BOUND_TYPES = ("blmvm", "bqnls", "bncg", "bqnkls", "bqnktr", "bqnktl", "bnls", "
 # applications). GPCG's goes through FreeSetPC (PETSc's GPCG ignores the preconditioning matrix; through it, it
 # took 434 -> 6520): under displacement control 161 / 330 / 260 pairs against 155 / 432 / 650 without at N = 512,
 # 217 / 413 / 334 against 250 / 672 / 1027 at 1024 (p* = 0.05 / 0.5 / 2); under the augmented Lagrangian 398
-# against 377 at N = 512, p* = 0.05, and the same stall at 0.5 and 2. TRON with its KSP at 0.1 took 127 / 191 / 178 pairs
-# with it against 116 / 192 / 432 without at N = 512, 137 / 201 / 196 against 144 / 245 / 467 at 1024
-# (p* = 0.05 / 0.5 / 2).
+# against 377 at N = 512, p* = 0.05, and the same stall at 0.5 and 2. TRON with its KSP at 0.1 took
+# 127 / 191 / 178 pairs with it against 116 / 192 / 432 without at N = 512, 137 / 201 / 196 against
+# 144 / 245 / 467 at 1024 (p* = 0.05 / 0.5 / 2).
 KSP_TYPES = ("bnls", "bntr", "bntl", "tron", "gpcg")
 FOURIER_DEFAULT_TYPES = ("bnls", "bntr", "bntl", "tron", "gpcg")
 QUASI_NEWTON_TYPES = ("blmvm", "bqnls", "bqnkls", "bqnktr", "bqnktl")
