@@ -1,13 +1,19 @@
 """The second-order half of an adhesive solution's local-minimum certificate: the least curvature of the energy.
 
 At a gap g that meets the first-order conditions, the energy Pi(g) (:mod:`~roughpetsc.contact.adhesive`) has no
-descent direction to first order; it is a strict local minimum when its Hessian S + diag(phi''(g)) is positive on
-the directions that keep the constraints to first order: zero on the nodes in contact (g = 0) and of zero mean
-(the mean gap is prescribed). Its least eigenvalue there is reported over s1 = pi E* / L, the stiffness of the
-longest wavelength. S alone gives at least 1 on zero-mean directions, so with phi'' >= -s1 on the free nodes (any
-Dugdale law, whose phi'' is zero off its kink) the bound 1 + min phi'' / s1 >= 0 certifies without a solve.
-Otherwise SLEPc's LOBPCG finds it, preconditioned by the compliance (the inverse of S), to an absolute
-residual of :data:`TOLERANCE` s1.
+descent direction to first order; it is a strict local minimum when its Hessian H = S + diag(phi''(g)) is positive
+on the directions that keep the constraints to first order: zero on the nodes in contact (g = 0) and of zero mean
+(the mean gap is prescribed). Curvatures are reported over s1 = pi E* / L, the stiffness of the longest
+wavelength. S alone gives at least 1 on zero-mean directions, so with phi'' >= -s1 on the free nodes (any Dugdale
+law, whose phi'' is zero off its kink) the bound 1 + min phi''/s1 >= 0 certifies without a solve.
+
+Otherwise the certificate is the least eigenvalue nu of C H, C the compliance (the inverse of S) on the same
+directions, found by SLEPc's Krylov-Schur to an absolute residual of :data:`TOLERANCE`. C is positive definite
+there, so C H has the inertia of H (Sylvester's law): nu > 0 exactly when H is positive definite, and as
+C <= 1/s1, H >= nu s1 when nu >= 0. So nu is a lower bound of the least curvature over s1, of the same sign, not
+that curvature itself. C H is the operator the gap CG iterates with, so its least eigenvalue converges in tens of
+products. LOBPCG on H itself, preconditioned by C, took 5-10x the operator applications: its residual is in S's
+units, so it had to resolve the highest wavenumbers, and it reapplied H to its whole basis every iteration.
 """
 
 import numpy as np
@@ -15,7 +21,7 @@ from petsc4py import PETSc
 
 from ..parallel import allmin, allsum
 
-# The least curvature is found to this absolute residual, in units of s1: a value below -TOLERANCE is negative.
+# nu (the module's docstring) is found to this absolute residual of C H x - nu x; a value below -TOLERANCE is negative.
 TOLERANCE = 1e-2
 MAX_ITERATIONS = 500
 
@@ -62,12 +68,13 @@ def longest_wave_stiffness(problem):
 
 
 def least_curvature(problem, gap, s1, mode=None):
-    """The least eigenvalue over ``s1`` of the energy's Hessian on the feasible zero-mean directions at the local
-    scaled ``gap`` of the adhesive ``problem``: ``(value, how)``, how "bound" or "LOBPCG, K iterations".
+    """A lower bound, of the same sign, of the least eigenvalue over ``s1`` of the energy's Hessian on the feasible
+    zero-mean directions at the local scaled ``gap`` of the adhesive ``problem`` (the module's docstring says
+    which): ``(value, how)``, how "bound" or "Krylov-Schur, K iterations".
 
-    ``mode``: a local array of gap's shape, LOBPCG's start where nonzero on the free nodes (the last step's
-    eigenvector along a path: a few iterations), overwritten with this one's. Returns (None, reason) if no free
-    node is left, or if LOBPCG does not converge.
+    ``mode``: a local array of gap's shape, the eigen-solve's start where nonzero on the free nodes (the last step's
+    eigenvector along a path), overwritten with this one's. Returns (None, reason) if no free node is left, or if
+    the eigen-solve does not converge.
     """
     g = gap.ravel()
     free = g > 0
@@ -83,24 +90,20 @@ def least_curvature(problem, gap, s1, mode=None):
 
     hessian = _Projected(problem, free, curvature, count, problem.operator.elastic_pressure)
     compliance = _Projected(problem, free, None, count, problem.operator.displacement)
+    preconditioned = _Product(hessian, compliance)
     comm = problem.heights.getComm()
-    mat = PETSc.Mat().createPython(((count_local, count), (count_local, count)), context=hessian, comm=comm)
+    mat = PETSc.Mat().createPython(((count_local, count), (count_local, count)), context=preconditioned, comm=comm)
     eps = SLEPc.EPS().create(comm)
     start = mat.createVecLeft()
     try:
         mat.setUp()
         eps.setOperators(mat)
-        eps.setProblemType(SLEPc.EPS.ProblemType.HEP)
-        eps.setType(SLEPc.EPS.Type.LOBPCG)
+        # C H is self-adjoint in the product of C's inverse, not in the Euclidean one: non-Hermitian to SLEPc.
+        eps.setProblemType(SLEPc.EPS.ProblemType.NHEP)
+        eps.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
         eps.setWhichEigenpairs(SLEPc.EPS.Which.SMALLEST_REAL)
         eps.setConvergenceTest(SLEPc.EPS.Conv.ABS)
-        eps.setTolerances(tol=TOLERANCE * s1, max_it=MAX_ITERATIONS)
-        ksp = eps.getST().getKSP()
-        eps.getST().setType(SLEPc.ST.Type.PRECOND)
-        ksp.setType(PETSc.KSP.Type.PREONLY)
-        pc = ksp.getPC()
-        pc.setType(PETSc.PC.Type.PYTHON)
-        pc.setPythonContext(_PC(compliance))
+        eps.setTolerances(tol=TOLERANCE, max_it=MAX_ITERATIONS)
         values = mode.ravel()[free] if mode is not None else np.zeros(count_local)
         if not allsum(problem.mpi, [np.dot(values, values)])[0] > 0:
             # A fixed start, the same on any number of ranks: a function of the global node number.
@@ -110,25 +113,32 @@ def least_curvature(problem, gap, s1, mode=None):
         eps.setInitialSpace([start])
         eps.solve()
         if eps.getConverged() < 1:
-            return None, f"LOBPCG did not converge in {eps.getIterationNumber()} iterations"
+            return None, f"Krylov-Schur did not converge in {eps.getIterationNumber()} iterations"
+        value = eps.getEigenpair(0, start)
         if mode is not None:
-            eps.getEigenpair(0, start)
             mode[...] = 0.0
             mode.ravel()[free] = start.getArray(readonly=True)
-        return eps.getEigenvalue(0).real / s1, f"LOBPCG, {eps.getIterationNumber()} iterations"
+        return value.real, f"Krylov-Schur, {eps.getIterationNumber()} iterations"
     finally:
         for obj in (start, eps, mat):
             obj.destroy()
-        hessian.release()
-        compliance.release()
+        for context in (preconditioned, hessian, compliance):
+            context.release()
 
 
-class _PC:
-    """PCPYTHON context: the projected compliance (a separate object: the MATPYTHON context given as a PCPYTHON
-    one too crashed PETSc)."""
+class _Product:
+    """MATPYTHON context: x -> second(first(x)) of two :class:`_Projected`, here the compliance after the Hessian."""
 
-    def __init__(self, context):
-        self.context = context
+    def __init__(self, first, second):
+        self.first, self.second = first, second
+        self.between = None
 
-    def apply(self, pc, x, y):
-        self.context.mult(None, x, y)
+    def mult(self, mat, x, y):
+        if self.between is None:
+            self.between = x.duplicate()
+        self.first.mult(None, x, self.between)
+        self.second.mult(None, self.between, y)
+
+    def release(self):
+        if self.between is not None:
+            self.between.destroy()
