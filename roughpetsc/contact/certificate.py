@@ -24,8 +24,9 @@ class KKTReport:
     min_p : min(p) / pbar (primal feasibility, >= 0 at a solution).
     min_g : min(g) / sqrt(m0^h) over the nodes below the cap (dual feasibility, >= 0 at a solution).
     load_error : |mean(p) - pbar| / pbar under load control, None under displacement control.
-    min_curvature : adhesive contact: the least curvature of the energy on the feasible directions, over the
-        stiffness of the longest wavelength, or its lower bound 1 + min phi''/s1 where that is >= 0 (any Dugdale law)
+    min_curvature : adhesive contact: a lower bound, of the same sign, of the least curvature of the energy on the
+        feasible directions over the stiffness s1 of the longest wavelength: 1 + min phi''/s1 where that is >= 0
+        (any Dugdale law), else the least eigenvalue of the compliance times the Hessian
         (:mod:`~roughpetsc.contact.curvature`; > 0: a strict local minimum); None where not checked.
     """
 
