@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from ..errors import ParameterError
+from . import loops
 
 LAWS = ("none", "dugdale", "exponential")
 
@@ -50,20 +51,15 @@ class Dugdale:
 
     def energy_change(self, gap, trial):
         """``phi(trial) - phi(gap)`` node by node, as sigma0 (min(trial, h0) - min(gap, h0)) (no w to cancel)."""
-        return self.energy_changes_from(gap)(trial, np.empty_like(trial))
+        return self.stress * (np.minimum(trial, self.range) - np.minimum(gap, self.range))
 
-    def energy_changes_from(self, gap, scratch=None):
-        """``change(trial, out)``: :meth:`energy_change` from ``gap`` into ``out`` (may be ``trial``), the part of
-        ``gap`` made once; ``scratch``: two arrays of gap's shape it may keep (allocated if None)."""
-        base = np.minimum(gap, self.range, out=None if scratch is None else scratch[0])
+    def energy_change_along(self, gap, direction, step):
+        """The local sum of :meth:`energy_change` from ``gap`` to ``gap - step direction``, in one pass."""
+        return loops.dugdale_change_along(gap, direction, step, self.stress, self.range)
 
-        def change(trial, out):
-            np.minimum(trial, self.range, out=out)
-            out -= base
-            out *= self.stress
-            return out
-
-        return change
+    def curvature_along(self, gap, direction):
+        """The local sum of phi''(gap) direction^2: 0 off the kink."""
+        return 0.0
 
     def force(self, gap, out=None):
         return np.multiply(np.less(gap, self.range), self.stress, out=out)
@@ -99,39 +95,23 @@ class Exponential:
         return -self.work * np.exp(-gap / self.range)
 
     def energy_change(self, gap, trial):
-        """``phi(trial) - phi(gap)`` node by node, without cancellation for close gaps.
+        """``phi(trial) - phi(gap)`` node by node, without cancellation for close gaps and without a positive
+        exponent, so no range however short overflows (:func:`~roughpetsc.contact.loops.exponential_changes`).
 
         Below g = 0 phi continues along its tangent at 0 (as Dugdale's does): a long step gains bounded energy.
         """
-        return self.energy_changes_from(gap)(trial, np.empty_like(trial))
+        gap, trial = np.broadcast_arrays(np.asarray(gap, dtype=float), np.asarray(trial, dtype=float))
+        out = np.empty(gap.shape)
+        loops.exponential_changes(gap.ravel(), trial.ravel(), self.work, self.range, out.ravel())
+        return out
 
-    def energy_changes_from(self, gap, scratch=None):
-        """``change(trial, out)`` as Dugdale's; ``scratch``: three arrays of gap's shape (allocated if None).
+    def energy_change_along(self, gap, direction, step):
+        """The local sum of :meth:`energy_change` from ``gap`` to ``gap - step direction``, in one pass."""
+        return loops.exponential_change_along(gap, direction, step, self.work, self.range)
 
-        phi(t) - phi(g) = s phi(min(g, t)) expm1(-|g - t| / rho), s = sign(t - g): no cancellation for close
-        gaps, and no positive exponent, so no range however short overflows.
-        """
-        difference, smaller, factor = scratch if scratch is not None else (
-            np.empty_like(gap), np.empty_like(gap), np.empty_like(gap))
-
-        def change(trial, out):  # out may be trial
-            np.maximum(trial, 0.0, out=smaller)
-            np.subtract(trial, smaller, out=out)  # the part of the trial below 0, on phi's tangent there
-            out *= self.peak_stress
-            np.subtract(gap, smaller, out=difference)            # g - t
-            np.minimum(smaller, gap, out=smaller)
-            np.multiply(smaller, -1.0 / self.range, out=smaller)
-            np.exp(smaller, out=smaller)
-            np.multiply(smaller, -self.work, out=smaller)        # phi(min(g, t))
-            np.abs(difference, out=factor)
-            np.multiply(factor, -1.0 / self.range, out=factor)
-            np.expm1(factor, out=factor)                         # expm1(-|g - t| / rho)
-            np.copysign(factor, difference, out=factor)          # s expm1(...), as expm1 <= 0: the sign of g - t
-            np.multiply(factor, smaller, out=factor)
-            out += factor
-            return out
-
-        return change
+    def curvature_along(self, gap, direction):
+        """The local sum of phi''(gap) direction^2, in one pass."""
+        return loops.exponential_curvature_along(gap, direction, self.work, self.range)
 
     def force(self, gap, out=None):
         out = np.divide(gap, -self.range, out=out)

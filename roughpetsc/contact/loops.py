@@ -5,6 +5,8 @@ cap is ``upper`` (``inf`` without one). Masks are 0.0/1.0 floats (``contact``, `
 (``open_nodes``).
 """
 
+import math
+
 from numba import njit
 
 
@@ -331,3 +333,49 @@ def finish_initial_hessian(out, source, mask, shift, mean_term, fixed_scale, gam
         free = gamma * (out[i] - shift + mean_term)
         fixed = gamma * fixed_scale * source[i]
         out[i] = free if mask[i] > 0.0 else fixed
+
+
+@njit(cache=True)
+def _exponential_change(gap, trial, work, range_):
+    """phi(trial) - phi(gap) of phi = -w exp(-g / rho), continued below 0 by its tangent there, without cancellation
+    and without a positive exponent: s phi(min(g, t)) expm1(-|g - t| / rho), s the sign of t - g."""
+    above = max(trial, 0.0)
+    change = (trial - above) * (work / range_)
+    difference = gap - above
+    factor = math.copysign(math.expm1(-abs(difference) / range_), difference)
+    return change + factor * (-work * math.exp(-min(above, gap) / range_))
+
+
+@njit(cache=True)
+def exponential_changes(gap, trial, work, range_, out):
+    """``out = phi(trial) - phi(gap)`` node by node (:func:`_exponential_change`)."""
+    for i in range(gap.size):
+        out[i] = _exponential_change(gap[i], trial[i], work, range_)
+    return out
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def exponential_change_along(gap, direction, step, work, range_):
+    """Local sum of phi(g - step d) - phi(g) (:func:`_exponential_change`): the line search's law part, no array."""
+    total = 0.0
+    for i in range(gap.size):
+        total += _exponential_change(gap[i], gap[i] - step * direction[i], work, range_)
+    return total
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def exponential_curvature_along(gap, direction, work, range_):
+    """Local sum of phi''(g) d^2 = -(w / rho^2) exp(-g / rho) d^2."""
+    total = 0.0
+    for i in range(gap.size):
+        total += math.exp(-gap[i] / range_) * direction[i] * direction[i]
+    return -work / (range_ * range_) * total
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def dugdale_change_along(gap, direction, step, stress, range_):
+    """Local sum of phi(g - step d) - phi(g) of the Dugdale law: sigma0 (min(t, h0) - min(g, h0))."""
+    total = 0.0
+    for i in range(gap.size):
+        total += min(gap[i] - step * direction[i], range_) - min(gap[i], range_)
+    return stress * total

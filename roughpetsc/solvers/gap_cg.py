@@ -46,11 +46,8 @@ class _Scratch:
 
     def __init__(self, size):
         self.r = np.empty(size)
-        self.work = np.empty(size)
         self.free = np.empty(size)
         self.open = np.empty(size, dtype=bool)
-        # the line search's parts of phi (interaction laws' energy_changes_from)
-        self.law = (np.empty(size), np.empty(size), np.empty(size))
         self.before = np.empty(size)  # the gap before a step, and S (g + h) there: a projected step may be undone
         self.elastic = np.empty(size)
         self.best = np.empty(size)  # an iterate near the lowest natural residual, returned by a stop short of it
@@ -99,7 +96,7 @@ class GapCG:
         z = problem.local(preconditioned_vec).ravel()
         r_old = problem.local(previous_vec).ravel()
         scratch = _Scratch(g.size)
-        r, work, free = scratch.r, scratch.work, scratch.free
+        r, free = scratch.r, scratch.free
         t[...] = 0.0
         r_old[...] = 0.0
         project_mean(mpi, g, target, n)
@@ -154,7 +151,7 @@ class GapCG:
                     break
             operator.elastic_pressure(direction_vec, response_vec)  # S t
             curvature_elastic, elastic_slope = allsum(mpi, loops.two_dots(t, response, elastic))
-            curvature = curvature_elastic + _law_curvature(law, mpi, g, t, work)
+            curvature = curvature_elastic + allsum(mpi, [law.curvature_along(g, t)])[0]
             if not curvature > 0:
                 curvature = curvature_elastic
             change, projected = self._descend(gap_vec, t, slope, (curvature_elastic, elastic_slope),
@@ -186,7 +183,7 @@ class GapCG:
         elastic_vec = self.vecs[4]
         g, elastic, response = (problem.local(v).ravel() for v in (gap_vec, elastic_vec, self.vecs[1]))
         while True:
-            step, change = _armijo_step(problem, g, t, slope, *elastic_parts, step, scratch.work, scratch.law)
+            step, change = _armijo_step(problem, g, t, slope, *elastic_parts, step)
             if step is None:
                 return None, False
             np.copyto(scratch.before, g)
@@ -234,16 +231,6 @@ def _restrict(mpi, v, free, count):
     loops.shift_on(v, free, total / count, v)
 
 
-def _law_curvature(law, mpi, g, t, work):
-    """``<phi''(g), t^2>``: the law's part of the curvature along t (0 for a piecewise-linear law)."""
-    if not law.curved:
-        return 0.0
-    law.curvature(g, out=work)
-    work *= t
-    total, = allsum(mpi, [np.dot(work, t)])
-    return total
-
-
 def _feasible(mpi, t, r, open_nodes, open_count):
     """Make ``-t`` a feasible direction at g = 0 (in place); returns the slope ``<r, t>`` of the energy.
 
@@ -254,7 +241,7 @@ def _feasible(mpi, t, r, open_nodes, open_count):
     return slope
 
 
-def _armijo_step(problem, g, t, slope, curvature_elastic, elastic_slope, step, trial, law_scratch):
+def _armijo_step(problem, g, t, slope, curvature_elastic, elastic_slope, step):
     """The first of ``step``, step/2, ... along -t that decreases the energy enough, and that decrease (None, None if
     none does).
 
@@ -262,11 +249,8 @@ def _armijo_step(problem, g, t, slope, curvature_elastic, elastic_slope, step, t
     summed node-wise, free of cancellation: -s <S(g + h), t> + s^2/2 <t, S t> + sum (phi(g - s t) - phi(g)).
     """
     law, mpi = problem.scaled_law, problem.mpi
-    changes = law.energy_changes_from(g, law_scratch)
     for _ in range(MAX_BACKTRACKS):
-        np.multiply(t, -step, out=trial)
-        trial += g
-        law_change, = allsum(mpi, [changes(trial, trial).sum()])
+        law_change, = allsum(mpi, [law.energy_change_along(g, t, step)])
         change = step * (0.5 * step * curvature_elastic - elastic_slope) + law_change
         if change <= -ARMIJO * step * slope:
             return step, change
