@@ -15,7 +15,7 @@ OPTIONS = [
     ("adhesion_range", 0.0, "range of the law, length units: rho (exponential) or h0 (dugdale)"),
     ("adhesion_curvature", True, "certify each result a local minimum to second order: the least curvature of the "
                                  "energy on the feasible directions, kkt.min_curvature (an exponential law costs "
-                                 "an eigen-solve of 0.25-0.4x the solve's FFT pairs; false: not checked)"),
+                                 "one or two eigen-solves, 0.07-1.3x the solve's FFT pairs; false: not checked)"),
 ]
 
 
