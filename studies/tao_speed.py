@@ -339,7 +339,10 @@ def report(rows, profile, folder):
              "Single runs beside those jobs had flattered the TAO types: PK gained more from a quiet machine "
              "(0.26 s against 0.40 s at N = 512, p* = 0.05) than they did. The `al` rows (`--variants al --solvers "
              "blmvm bqnls tron --max-time 200`; GPCG's, which stall at p* >= 0.5 after 300 s, from the run before) "
-             "are single runs from earlier sessions, whose PK they divide by no longer.",
+             "are single runs from earlier sessions, whose PK they divide by no longer. The N = 2048 rows (p* = 0.5; "
+             "`--sizes 2048 --pstars 0.5 --solvers blmvm bqnls --variants after before --max-time 300`) are single "
+             "runs beside the test suite, for the initial Hessian at N = 2048: under displacement control `before` "
+             "is PETSc's (`-bound_h0 none`) and `after` the Fourier one; both with today's callbacks.",
              ""] + TRIED
     if rows:
         lines += ["## Load against displacement control, every bound type (item 1)", "",
