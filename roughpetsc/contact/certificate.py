@@ -26,7 +26,8 @@ class KKTReport:
     load_error : |mean(p) - pbar| / pbar under load control, None under displacement control.
     min_curvature : adhesive contact: a lower bound, of the same sign, of the least curvature of the energy on the
         feasible directions over the stiffness s1 of the longest wavelength: 1 + min phi''/s1 where that is >= 0
-        (any Dugdale law), else the least eigenvalue of the compliance times the Hessian
+        (any Dugdale law), else the relaxed bound where that is >= 0, else the least eigenvalue of the compliance
+        times the Hessian
         (:mod:`~roughpetsc.contact.curvature`; > 0: a strict local minimum); None where not checked.
     """
 

@@ -95,7 +95,8 @@ def least_curvature(problem, gap, s1, mode=None):
     if 1.0 + least / s1 >= 0.0:
         return 1.0 + least / s1, "bound"
     nodes = np.flatnonzero(free) + problem.local_rows.start * gap.shape[-1]
-    # A fixed start, the same on any number of ranks: a function of the global node number.
+    # A fixed start, the same on any number of ranks: a function of the global node number. The relaxed solve
+    # leaves its eigenvector in it (weight where |phi''| is largest), which starts nu's solve when no mode is given.
     fixed = np.sin(1.0 + 0.7548776662466927 * nodes)
     weighted = _Weighted(problem, free, np.sqrt(np.maximum(-curvature, 0.0)))
     try:

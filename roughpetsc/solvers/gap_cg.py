@@ -151,7 +151,8 @@ class GapCG:
                     break
             operator.elastic_pressure(direction_vec, response_vec)  # S t
             curvature_elastic, elastic_slope = allsum(mpi, loops.two_dots(t, response, elastic))
-            curvature = curvature_elastic + allsum(mpi, [law.curvature_along(g, t)])[0]
+            # A piecewise-linear law adds nothing: no reduction over the ranks for it.
+            curvature = curvature_elastic + (allsum(mpi, [law.curvature_along(g, t)])[0] if law.curved else 0.0)
             if not curvature > 0:
                 curvature = curvature_elastic
             change, projected = self._descend(gap_vec, t, slope, (curvature_elastic, elastic_slope),
