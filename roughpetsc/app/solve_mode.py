@@ -75,9 +75,9 @@ OPTIONS = LOAD_OPTIONS + PHYSICS_OPTIONS + SETTINGS_OPTIONS
 
 def solver_options():
     """The options of the stopping rule and of each backend (imports PETSc: call it once PETSc is initialised)."""
-    from ..solvers import option_tables, stopping
+    from ..solvers import cascade, option_tables, stopping
 
-    return stopping.OPTIONS + [option for table in option_tables().values() for option in table]
+    return stopping.OPTIONS + cascade.OPTIONS + [option for table in option_tables().values() for option in table]
 
 SOLVER_HELP = """Solvers (PETSc options):
   (no -tao_type)          Polonsky-Keer projected CG (TAO type python) with the bound-constrained active set
@@ -451,9 +451,11 @@ def step_line(step):
     """The table row of a step summary."""
     flag = "" if step["converged"] else "  NOT CONVERGED"
     plastic = f"  A_plastic {step['A_plastic']:.5g}" if step.get("A_plastic") else ""
+    coarse = step.get("cascade_applications")
+    cascade = f"  + {coarse:.1f} Kapps of the coarse start (in fine-grid Kapps)" if coarse else ""
     return (f"{step['pstar']:10.5g} {step['A']:10.5g} {step['A_corrected']:10.5g} {step['gstar']:11.5g} "
             f"{step['kkt']['natural']:9.2e} {step['iterations']:6d} {step['operator_applications']:6d} "
-            f"{step['time_s']:8.3f}  {step['reason']}{flag}{plastic}")
+            f"{step['time_s']:8.3f}  {step['reason']}{flag}{plastic}{cascade}")
 
 
 def solve_path(settings, solver, record, comm, lines, requests, progress=None):

@@ -5,6 +5,7 @@ unknown) follow the continuation protocol of :mod:`roughpetsc.solvers.protocol`.
 """
 
 import numpy as np
+from petsc4py import PETSc
 
 from ..errors import ParameterError
 from ..parallel import allsum
@@ -27,6 +28,9 @@ class PressureContinuation:
         The solution before the last (load paths only).
     targets : list of float
         Scaled loads of the solutions in (previous, pressure).
+    cold_start : callable or None
+        ``cold_start(target, pressure)`` puts the start of a cold load-controlled solve (no solution before it)
+        in ``pressure`` (any mean): the cascade of :mod:`roughpetsc.solvers.cascade`. None: the uniform load.
     """
 
     def __init__(self, problem, keeps_displacement):
@@ -39,6 +43,7 @@ class PressureContinuation:
         # K p of the solutions in targets, K p of the start, every Vec made for them.
         self.displacements, self.start_displacement, self.pool = [], None, []
         self.last_separation = None
+        self.cold_start = None
 
     @property
     def unknown(self):
@@ -60,13 +65,15 @@ class PressureContinuation:
             self.pressure.set(0.0)
         if control == "displacement":
             return Guess()
-        return Guess(separation=self.last_separation, displacement=self.load_start(target), confirm=False)
+        return Guess(separation=self.last_separation, displacement=self.load_start(target, start != "uniform"),
+                     confirm=False)
 
-    def load_start(self, target):
+    def load_start(self, target, cold_start=True):
         """Put the start of a load-controlled solve at ``target`` in :attr:`pressure`; its K p if known.
 
         After two load-controlled solves, linear extrapolation in the load (step ratio capped at 2), projected
-        onto p >= 0; after one, that solution; with none, uniform; then scaled to the new mean pressure.
+        onto p >= 0; after one, that solution; with none, the pressure held (a displacement-controlled solution,
+        a resumed one) or from zero :attr:`cold_start`'s (if set and ``cold_start``), else uniform; then scaled to the new mean pressure.
         Returns K p of the start when the kept K p of the previous solutions give it exactly (one FFT pair
         saved per step), else None. Higher-order predictors started no closer (studies/load_history.py).
         """
@@ -99,6 +106,9 @@ class PressureContinuation:
             self.pressure.copy(self.previous)
             if known:
                 displacements[0].copy(self.start_displacement)
+        elif cold_start and self.cold_start is not None and self.pressure.norm(PETSc.NormType.INFINITY) == 0:
+            self.cold_start(target, self.pressure)
+            known = False  # K p of this start is computed by the backend
         elif known:
             self.start_displacement.set(0.0)
         mean_p = self.pressure.sum() / self.problem.n

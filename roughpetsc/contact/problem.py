@@ -90,6 +90,7 @@ class ContactProblem:
         self.pressure_scale = self.E_star * self.height_scale / grid.l1
         self.scaled_grid = Grid(grid.n0, grid.n1, grid.l0 / grid.l1, 1.0)
         self.boundary = boundary
+        self.fft_threads, self.fft_effort = fft_threads, fft_effort
         self.operator = operator_factory(boundary, self.scaled_grid, 1.0, self.comm, fft_threads, fft_effort)
         self.local_rows = self.operator.local_rows
         self.heights = self.operator.vec()

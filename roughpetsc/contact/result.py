@@ -21,7 +21,9 @@ class Result:
     Pressures in pressure units, gaps in length units; ``pstar`` = pbar / sqrt(m0^p), ``gstar`` = gbar /
     sqrt(m0^h); ``A`` by node count (3.45), ``A_corrected`` with the perimeter correction; ``rms_gap_contact``
     (3.50) over the elastic contact nodes; ``A_plastic`` the fraction of nodes at the cap; ``energy`` the total
-    energy per unit area of an adhesive solution (pressure x length units, :mod:`~roughpetsc.contact.adhesive`).
+    energy per unit area of an adhesive solution (pressure x length units, :mod:`~roughpetsc.contact.adhesive`);
+    ``cascade_applications`` the FFT pairs of a cold start's coarse solves (:mod:`roughpetsc.solvers.cascade`)
+    in fine-grid pairs (each level's weighted by its size), beside ``operator_applications`` on the grid itself.
     """
 
     pbar: float
@@ -43,6 +45,7 @@ class Result:
     history: np.ndarray = field(default=None, repr=False)
     A_plastic: float = 0.0
     energy: float = None
+    cascade_applications: float = 0.0
 
     def summary(self):
         """A JSON-ready dict (no fields, no history)."""

@@ -5,6 +5,7 @@ import time
 import numpy as np
 
 from ..errors import ParameterError
+from .cascade import make_cascade
 from .options import SolverOptions
 from .protocol import BackendSettings, Guess, Outcome
 from .registry import make_backend
@@ -56,6 +57,13 @@ class Solver:
         self.name = self.backend.name
         keeps_displacement = control == "load" and self.backend.keeps_displacement
         self.path = problem.continuation(keeps_displacement)
+        try:
+            self.cascade = make_cascade(problem, control, self.options.prefix)
+        except BaseException:
+            self.destroy()
+            raise
+        if self.cascade is not None:
+            self.path.cold_start = self.cascade
         self.work = problem.vec()  # the certificate's gradient: the gap (contact), S (g + h) (adhesive)
         self.last = None
         unused = self.options.unused()
@@ -107,6 +115,8 @@ class Solver:
             outcome = Outcome(resumed.separation, outcome.iterations + resumed.iterations, resumed.reason,
                               np.concatenate([outcome.history, resumed.history]))
             result = self._certify(outcome, target, started, applications)
+        if self.cascade is not None:
+            result.cascade_applications = self.cascade.take_pairs()
         self.path.record(control, target, outcome, self.work)
         self.last = result
         return result
