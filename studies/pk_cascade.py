@@ -417,12 +417,13 @@ class FixedSetRun:
     history: list = field(default_factory=list)
 
 
-def fixed_set_pcg(level, contact, pbar, preconditioner, rtol=1e-8, extra_rtol=None, max_it=2000):
+def fixed_set_pcg(level, contact, pbar, preconditioner, rtol=1e-8, extra_rtol=None, max_it=2000, start=None):
     """Preconditioned CG for the load-controlled QP on the fixed contact set ``contact`` (bool, flat).
 
     The floor of issue 39: ``K_CC p + d = h_C``, ``sum p = n pbar``, p = 0 off C, from the natural start
     ``p = n pbar / |C|`` on C (the uniform pressure carrying the load on the exact set: nothing but the set
-    is known). Each iteration costs two pairs (``B r`` and ``K t``); the gap is updated (``u -= alpha K t``),
+    is known), or from ``start`` (a pressure, flat) set to zero off C and scaled to carry the load (the warm
+    floor of a load step). Each iteration costs two pairs (``B r`` and ``K t``); the gap is updated (``u -= alpha K t``),
     and the natural residual of the whole grid, ``max |min(p / pbar, g)|`` with ``d = -mean_C(K p - h)``,
     is checked on it; the first time it is at most ``rtol`` the residual is recomputed on a fresh
     ``K p`` (the certificate), and the pairs are ``1 + 2 k + 1``. With ``extra_rtol`` CG then continues
@@ -432,7 +433,11 @@ def fixed_set_pcg(level, contact, pbar, preconditioner, rtol=1e-8, extra_rtol=No
     size = contact.size
     count = int(contact.sum())
     start_pairs = level.pairs
-    p = np.where(contact, size * pbar / count, 0.0)
+    if start is None:
+        p = np.where(contact, size * pbar / count, 0.0)
+    else:
+        p = np.where(contact, start, 0.0)
+        p *= size * pbar / p.sum()
     u, q, z, t, r = (np.zeros(size) for _ in range(5))
     level.compliance(p, u)
     preconditioner.setup(contact)

@@ -19,8 +19,9 @@ Parts (``--parts``):
 - ``reference``: today's default solver (Polonsky-Keer, BCCG active set, Fourier preconditioner) to a natural
   residual of 1e-12. Its contact set {p > 0} is *the exact final contact set* C (kept as a bit mask in
   ``--cache``, outside the repository).
-- ``pk``: today's default solver, cold, to 1e-8 (``common.solve``: the Solver facade, its certificate
-  included): iterations, FFT pairs (``operator.applications``), seconds.
+- ``pk``: today's default solver, cold from the uniform pressure (``-cascade_coarsest 0``), to 1e-8
+  (``common.solve``: the Solver facade, its certificate included): iterations, FFT pairs
+  (``operator.applications``), seconds.
 - ``floor``: *the floor*: preconditioned CG on the fixed set C for the load-controlled QP
   (``K_CC p + d = h_C``, ``sum p = n pbar``, p = 0 off C), from the natural start (the uniform pressure
   ``n pbar / |C|`` on C: the set and nothing else is known), until the natural KKT residual of the whole
@@ -34,14 +35,22 @@ Parts (``--parts``):
   ``--cold`` variant (:data:`COLD_VARIANTS`): FFT pairs of every level weighted by (N_c/N)^2, the
   certificate included, and an independent certificate afterwards (a fresh gap through
   ``ContactProblem.gap`` and ``roughpetsc.contact.certificate.report``, not counted).
+- ``pkcascade``: today's solver from the cascade start (``-cascade_coarsest 256``,
+  :mod:`roughpetsc.solvers.cascade`), cold, to 1e-8: the ``pk-cascade`` column of the cold table, its coarse
+  pairs weighted by (N_c / N)^2.
+- ``projections``: how many nodes each projected step of today's solver moves, from the uniform and the
+  cascade start (:func:`run_projections`).
 - ``slepc``: the Lanczos estimates checked against SLEPc (Krylov-Schur on ``B P K_CC P``, the constant on
   C deflated) at the smallest size and load given.
 - ``warm``: the load history (7.11) (95 steps) at ``--warm-n``: pairs per warm step against one cold solve
   at p* = 0.5, for today's solver (``roughpetsc.load_path``'s linear predictor) and for the prototype with
   the same predictor.
+- ``warmfloor``: what limits a warm step (:func:`run_warm_floor`): CG on each step's own final contact set
+  from the predicted start, at ``--warm-n`` (p* = 0.5 keys only), one preconditioner per ``--floor-pcs``.
 """
 
 import argparse
+import json
 import os
 import sys
 import time
@@ -99,15 +108,22 @@ COLD_VARIANTS = {
 
 
 # --- problems and the reference contact set ----------------------------------------------------------------
+def make_heights(group, n):
+    """The grid and heights of ``options/groupNN.opts`` at n x n (generator xu, seed 1)."""
+    from roughpetsc import Grid, fractal, fractal_group
+
+    preset = fractal_group(group)
+    grid = Grid(n, n, preset["length"], preset["length"])
+    return grid, fractal(grid, preset["k_l"], preset["k_s"], preset["hurst"], preset["m2"], seed=1, generator="xu")
+
+
 def make_problem(group, n):
     """The surface of ``options/groupNN.opts`` at n x n (generator xu, seed 1), E* = 1, one process."""
     from petsc4py import PETSc
 
-    from roughpetsc import ContactProblem, Grid, fractal, fractal_group
+    from roughpetsc import ContactProblem
 
-    preset = fractal_group(group)
-    grid = Grid(n, n, preset["length"], preset["length"])
-    heights = fractal(grid, preset["k_l"], preset["k_s"], preset["hurst"], preset["m2"], seed=1, generator="xu")
+    grid, heights = make_heights(group, n)
     return ContactProblem(grid, heights, 1.0, PETSc.COMM_SELF)
 
 
@@ -154,7 +170,7 @@ def parse_key(key):
 
 # --- parts ------------------------------------------------------------------------------------------------
 def run_pk(problem, pstar, key, rows, path):
-    result, _, seconds = common.solve(problem, {}, RTOL, pstar=pstar)
+    result, _, seconds = common.solve(problem, {"cascade_coarsest": 0}, RTOL, pstar=pstar)
     add_row(rows, path, dict(part="pk", key=key, variant="pk", iterations=result.iterations,
                              pairs=result.operator_applications, natural=result.kkt.natural,
                              converged=result.converged, seconds=seconds))
@@ -219,6 +235,64 @@ def run_cold(problem, pstar, key, name, rows, path):
                              load_error=kkt.load_error,
                              converged=bool(kkt.natural <= RTOL and kkt.load_error <= RTOL),
                              levels=levels, seconds=seconds, setup_seconds=setup))
+
+
+def run_pk_cascade(problem, pstar, key, rows, path, coarsest=256):
+    """Today's solver from the cascade start (:mod:`roughpetsc.solvers.cascade`, ``-cascade_coarsest``), the
+    variant ``pk-cascade`` of the cold table: the fine grid's pairs (its certificate included) plus the coarse
+    levels' weighted by (N_c / N)^2; timed beside a solve from the uniform start in the same run (the coarse
+    grids' set-up and FFTW plans inside the cascade's time)."""
+    from roughpetsc import Solver
+
+    measured = {}
+    for name, value in (("uniform", 0), ("cascade", coarsest)):  # paired: the same run times both starts
+        solver = Solver(problem, "load", None, RTOL, options={"cascade_coarsest": value})
+        try:
+            start = time.perf_counter()
+            measured[name] = (solver.solve(pstar=pstar), time.perf_counter() - start)
+        finally:
+            solver.destroy()
+    (uniform, uniform_seconds), (result, seconds) = measured["uniform"], measured["cascade"]
+    add_row(rows, path, dict(part="cold", key=key, variant="pk-cascade",
+                             pairs=result.operator_applications + result.cascade_applications,
+                             fine_pairs=result.operator_applications, coarse_pairs=result.cascade_applications,
+                             iterations=result.iterations, natural=result.kkt.natural,
+                             converged=bool(result.converged and uniform.converged), seconds=seconds,
+                             uniform_pairs=uniform.operator_applications, uniform_seconds=uniform_seconds))
+
+
+def run_projections(problem, pstar, key, rows, path, coarsest=256):
+    """How many nodes each projected step moves, for today's solver from the uniform and the cascade start.
+
+    Every step whose projection moved p costs a fresh K p (one pair); the counts say whether correcting u by
+    shifted kernel copies instead (no pair for a few nodes, about one sweep of the grid per node) could save
+    those pairs. The solver's step kernel is wrapped for the count (the study's own instrument).
+    """
+    from roughpetsc import Solver
+    from roughpetsc.contact import loops
+
+    moved, take_step = [], loops.take_step
+
+    def counting_step(*args):
+        clipped, total = take_step(*args)
+        moved.append(clipped)
+        return clipped, total
+
+    for name, value in (("uniform", 0), ("cascade", coarsest)):
+        loops.take_step = counting_step
+        solver = Solver(problem, "load", None, RTOL, options={"cascade_coarsest": value})
+        try:
+            moved.clear()
+            result = solver.solve(pstar=pstar)
+        finally:
+            loops.take_step = take_step
+            solver.destroy()
+        fine = np.array(moved[-result.iterations:]) if result.iterations else np.zeros(0, int)
+        steps = fine[fine > 0]
+        add_row(rows, path, dict(part="projections", key=key, variant=name, iterations=result.iterations,
+                                 pairs=result.operator_applications, moving_steps=int(steps.size),
+                                 at_most_16=int((steps <= 16).sum()), at_most_64=int((steps <= 64).sum()),
+                                 median_moved=float(np.median(steps)) if steps.size else 0.0))
 
 
 def run_slepc(problem, pstar, contact, key, name, rows, path):
@@ -359,11 +433,12 @@ def extrapolated_start(previous, loads, target):
     """The load path's linear predictor: the last two solutions extrapolated in the load (step ratio capped at
     2), projected onto p >= 0; the caller scales it to the load. ``previous``: [(pbar, p, K p)]."""
     if len(previous) == 1:
-        return previous[-1][1].copy(), previous[-1][2].copy()
+        p, u = previous[-1][1:]
+        return p.copy(), None if u is None else u.copy()
     (b0, p0, u0), (b1, p1, u1) = previous[-2], previous[-1]
     ratio = min((target - b1) / (b1 - b0), 2.0) if b1 != b0 else 0.0
     p = p1 + ratio * (p1 - p0)
-    u = u1 + ratio * (u1 - u0)
+    u = None if u1 is None else u1 + ratio * (u1 - u0)
     if (p < 0).any():
         return np.maximum(p, 0.0), None  # the projection moved p: K p of the start is computed afresh
     return p, u
@@ -426,6 +501,67 @@ def run_warm(problem, key, name, rows, path):
                              warm_pairs=float(warm), ratio=float(warm / cold_pairs),
                              time_ratio=float(seconds / len(loads) / cold_seconds), converged=int(converged),
                              start_residual=float(np.median(starts))))
+
+
+def quadratic_start(previous, target):
+    """The last three solutions extrapolated by the quadratic through them in the load, projected onto p >= 0.
+    ``previous``: [(pbar, p)]; with fewer than three, the linear predictor."""
+    if len(previous) < 3:
+        return extrapolated_start([(b, p, None) for b, p in previous], None, target)[0]
+    loads = [b for b, _ in previous[-3:]]
+    p = np.zeros_like(previous[-1][1])
+    for i, (b_i, p_i) in enumerate(previous[-3:]):
+        weight = np.prod([(target - b_j) / (b_i - b_j) for j, b_j in enumerate(loads) if j != i])
+        p += weight * p_i
+    return np.maximum(p, 0.0)
+
+
+# Starts of the warm floor: step k's start from the solutions of the steps before it ([(pbar, p)]).
+WARM_PREDICTORS = {
+    "linear": lambda previous, pbar: extrapolated_start([(b, p, None) for b, p in previous[-2:]], None, pbar)[0],
+    "quadratic": quadratic_start,
+    "previous": lambda previous, pbar: previous[-1][1].copy(),
+}
+
+
+def run_warm_floor(problem, key, name, rows, path):
+    """The floor of each warm step: CG on the step's own final contact set from a predicted start.
+
+    Today's solver walks the load history (7.11) as in the ``warm`` part; after step k its solution's contact
+    set C_k = {p_k > 0} (natural residual 1e-8) and a start predicted from the solutions of the steps before
+    (:data:`WARM_PREDICTORS`: ``linear`` is :func:`extrapolated_start`, the start today's solver is given)
+    make a fixed-set CG run (:func:`pk_cascade.fixed_set_pcg` with ``start``): the pairs a warm step would
+    cost if its final contact set were known, which no active-set method beats with the same preconditioner
+    and start. Steps 3 to 95 (the quadratic predictor needs three solutions).
+    """
+    from roughpetsc import Solver, load_history
+    import pk_cascade
+
+    loads = load_history()
+    level = pk_cascade.Level(fine_heights(problem), problem.grid.n0)
+    preconditioner = pk_cascade.make_preconditioner(level, PRECONDITIONERS[name])
+    solver = Solver(problem, "load", None, RTOL)
+    previous, pk_pairs = [], []
+    floors = {predictor: dict(pairs=[], start=[], certified=[]) for predictor in WARM_PREDICTORS}
+    try:
+        for pstar in loads:
+            pbar = problem.scaled_pbar(pstar=pstar)
+            result = solver.solve(pstar=pstar)
+            pressure = problem.local(solver.pressure, readonly=True).ravel().copy()
+            if len(previous) == 3:
+                pk_pairs.append(result.operator_applications)
+                for predictor, start in WARM_PREDICTORS.items():
+                    run = pk_cascade.fixed_set_pcg(level, pressure > 0, pbar, preconditioner, RTOL, max_it=400,
+                                                   start=start(previous, pbar))
+                    floors[predictor]["pairs"].append(run.pairs)
+                    floors[predictor]["start"].append(run.history[0])
+                    floors[predictor]["certified"].append(run.certified)
+            previous = (previous + [(pbar, pressure)])[-3:]
+    finally:
+        solver.destroy()
+        level.destroy()
+    add_row(rows, path, dict(part="warmfloor", key=key, variant=name, steps=len(pk_pairs), pk_pairs=pk_pairs,
+                             floors=floors))
 
 
 # --- report -----------------------------------------------------------------------------------------------
@@ -494,6 +630,28 @@ def cold_table(rows, keys, cold_names):
     return common.markdown_table(header, table)
 
 
+def cascade_breakdown_table(rows, keys):
+    """Where the cascade's pairs go against the floor: iterations, pairs beyond two per iteration, coarse pairs."""
+    table = []
+    for key in keys:
+        found = [r for r in rows_of(rows, "cold") if r["key"] == key and r["variant"] == "pk-cascade"]
+        floor = [r for r in rows_of(rows, "floor") if r["key"] == key and r["variant"] == "fourier"]
+        if not (found and floor):
+            continue
+        r, f = found[-1], floor[-1]
+        group, n, pstar = parse_key(key)
+        moved = [m for m in rows_of(rows, "projections") if m["key"] == key and m["variant"] == "cascade"]
+        moving = (f"{moved[-1]['moving_steps']} / {moved[-1]['at_most_16']} / {moved[-1]['median_moved']:.0f}"
+                  if moved else "-")
+        table.append([group, f"{pstar:g}", n, f["iterations"], r["iterations"], f["pairs"], r["fine_pairs"],
+                      r["fine_pairs"] - 2 * r["iterations"] - 2, f"{r['coarse_pairs']:.1f}",
+                      f"{r['pairs'] / f['pairs']:.2f}", moving])
+    return common.markdown_table(
+        ["group", "p*", "N", "floor iterations", "fine iterations", "floor pairs", "fine pairs",
+         "fresh K p after projections", "coarse pairs", "total / floor",
+         "steps that moved p / of them at most 16 nodes / median nodes moved"], table)
+
+
 def timing_table(rows, keys, cold_names):
     timing = []
     for key in keys:
@@ -503,7 +661,9 @@ def timing_table(rows, keys, cold_names):
         cells = []
         for name in cold_names:
             seconds = lookup(rows, "cold", key, name, "seconds")
-            cells.append(fmt(seconds / pk_seconds, ".2f") if seconds else "-")
+            # pk-cascade is timed beside a uniform start of its own run (paired)
+            reference = lookup(rows, "cold", key, name, "uniform_seconds") if name == "pk-cascade" else pk_seconds
+            cells.append(fmt(seconds / reference, ".2f") if seconds else "-")
         timing.append([key] + cells)
     return common.markdown_table(["case"] + cold_names, timing)
 
@@ -535,10 +695,97 @@ def warm_table(rows):
           f"{r['converged']}/{r['steps']}"] for r in rows_of(rows, "warm")])
 
 
+def warm_floor_table(rows):
+    """One line per predictor of each warm-floor row: pairs per step against the cold solve of the case."""
+    table = []
+    for r in rows_of(rows, "warmfloor"):
+        cold = lookup(rows, "warm", r["key"], "pk", "cold_pairs") or lookup(rows, "pk", r["key"], "pk")
+        floor = lookup(rows, "floor", r["key"], r["variant"])
+        pk = np.mean(r["pk_pairs"])
+        table.append([r["key"], "today's pk (its warm steps)", r["steps"], f"{pk:.1f}", f"{pk / cold:.3f}",
+                      f"{pk / floor:.2f}" if floor else "-", "-", "-"])
+        for predictor, run in r["floors"].items():
+            pairs = np.mean(run["pairs"])
+            table.append([r["key"], f"floor from the {predictor} start ({r['variant']})", r["steps"],
+                          f"{pairs:.1f}", f"{pairs / cold:.3f}", f"{pairs / floor:.2f}" if floor else "-",
+                          f"{np.median(run['start']):.1e}",
+                          f"{sum(c <= RTOL for c in run['certified'])}/{len(run['certified'])}"])
+    return common.markdown_table(["case", "warm step", "steps", "pairs per step", "over pk's cold solve",
+                                  "over the cold floor", "median start residual", "certified"], table)
+
+
+def plot_warm_floor(rows):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from roughpetsc import load_history
+
+    found = rows_of(rows, "warmfloor")
+    fig, axes = plt.subplots(1, len(found), figsize=(6.5 * len(found), 4.5), squeeze=False)
+    for axis, r in zip(axes[0], found):
+        loads = load_history()[-r["steps"]:]
+        cold = lookup(rows, "warm", r["key"], "pk", "cold_pairs") or lookup(rows, "pk", r["key"], "pk")
+        steps = np.arange(len(loads)) + len(load_history()) - len(loads) + 1
+        axis.plot(steps, r["pk_pairs"], "k-", label="today's pk, warm")
+        for predictor, run in r["floors"].items():
+            axis.plot(steps, run["pairs"], "--", label=f"floor, {predictor} start")
+        axis.axhline(0.35 * cold, color="r", lw=0.8, label=f"0.35 x cold ({cold:.0f} pairs)")
+        twin = axis.twinx()
+        twin.plot(steps, loads, ":", color="0.6")
+        twin.set_ylabel("p* of the step (dotted)")
+        axis.set_xlabel("step of the load history (7.11)")
+        axis.set_ylabel("FFT pairs to natural KKT 1e-8")
+        axis.set_title(r["key"])
+        axis.grid(alpha=0.3)
+        axis.legend(fontsize=7)
+    common.save_figure(fig, OUT, "warm_floor.png")
+
+
+def scaling_table(rows, keys):
+    """Iterations, pairs and seconds against N for today's solver and the prototype, beside the floor."""
+    table = []
+    for key in keys:
+        if lookup(rows, "pk", key, "pk") is None:
+            continue
+        group, n, pstar = parse_key(key)
+        pk = [lookup(rows, "pk", key, "pk", field) for field in ("iterations", "pairs", "seconds")]
+        best = [lookup(rows, "cold", key, "best", field) for field in ("iterations", "pairs", "seconds")]
+        table.append([group, f"{pstar:g}", n, fmt(lookup(rows, "floor", key, "fourier")), pk[0], pk[1],
+                      pk[1] - 2 * pk[0], fmt(pk[2], ".3g"), fmt(best[0]), fmt(best[1], ".1f"), fmt(best[2], ".3g"),
+                      fmt(best[2] / pk[2], ".2f") if best[2] else "-"])
+    return common.markdown_table(["group", "p*", "N", "floor pairs", "pk iterations", "pk pairs",
+                                  "pk pairs besides 2 per iteration", "pk s",
+                                  "best iterations (finest level)", "best pairs", "best s", "best s / pk s"],
+                                 table)
+
+
+def peer_table():
+    """Today's solver against Tamaas from ``studies/output/peers.json`` (one run, the same field judged by our
+    operator): iterations, operator applications and seconds against N."""
+    path = os.path.join(common.OUTPUT, "peers.json")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        peers = json.load(f)
+    table = []
+    for size in peers["sizes"]:
+        ours = next(r for r in size["rows"] if r["solver"] == "roughpetsc PK")
+        tamaas = next((r for r in size["rows"] if r["solver"].startswith("Tamaas")), None)
+        if tamaas is None:
+            continue
+        table.append([size["n"], ours["iterations"], ours["operator_applications"], f"{ours['time_s']:.3g}",
+                      tamaas["iterations"], f"{tamaas['time_s']:.3g}", f"{ours['time_s'] / tamaas['time_s']:.3f}"])
+    header = ["N", "pk iterations", "pk pairs", "pk s", "Tamaas PKR iterations",
+              "Tamaas s", "pk s / Tamaas s"]
+    return peers, common.markdown_table(header, table)
+
+
 def report(rows):
     keys = sorted({r["key"] for r in rows}, key=lambda k: (parse_key(k)[0], parse_key(k)[2], parse_key(k)[1]))
     floor_names = [n for n in PRECONDITIONERS if any(r["variant"] == n for r in rows_of(rows, "floor"))]
-    cold_names = [n for n in COLD_VARIANTS if any(r["variant"] == n for r in rows_of(rows, "cold"))]
+    cold_names = [n for n in list(COLD_VARIANTS) + ["pk-cascade"] if any(r["variant"] == n for r in rows_of(rows, "cold"))]
     lines = ["# The contact solver's floor, cold solves against it, and warm load steps (issue 39, items 1-4)", "",
              "Written by `studies/solver_scaling.py` from its `rows*.json` (its docstring defines every quantity; "
              "`studies/pk_cascade.py` describes the prototype solver step by step). FFT pairs and "
@@ -561,14 +808,28 @@ def report(rows):
     lines += ["## 2. Cold solves against the floor", "",
               "FFT pairs of a cold solve to a certified natural residual of 1e-8 (coarse levels weighted by "
               "(N_c/N)^2, the certificate included); in brackets the ratio to the Fourier floor of section 1. "
-              "`pk (today)`: the default solver (`python -m roughpetsc -options_file options/groupNN.opts "
-              "-surface_N N -pstar P`). The variants are `COLD_VARIANTS` of the study; `best` is the candidate "
+              "`pk (today)`: the default solver as it was before the cascade start (`python -m roughpetsc "
+              "-options_file options/groupNN.opts -surface_N N -pstar P -cascade_coarsest 0`); `pk-cascade`: the "
+              "same from the cascade start (`-cascade_coarsest 256`, the default at N >= 1024; "
+              "`roughpetsc/solvers/cascade.py`), its coarse pairs weighted. The variants are `COLD_VARIANTS` of the study; `best` is the candidate "
               "described in `pk_cascade.py`. `certified`: the cold variants of the case whose result passed "
               "an independent certificate (`ContactProblem.gap`, `kkt.report`).", "",
               cold_table(rows, keys, cold_names), "",
               "Wall time of each cold solve over today's `pk` on the same case (one run each; `pk` includes its "
-              "solver set-up, the variants do not include their grids' FFTW planning; noisy):", "",
+              "solver set-up, the variants do not include their grids' FFTW planning; noisy; `pk-cascade` over "
+              "a solve from the uniform start timed in the same run):", "",
               timing_table(rows, keys, cold_names), ""]
+    if any(r["variant"] == "pk-cascade" for r in rows_of(rows, "cold")):
+        lines += ["Where the pairs of `pk-cascade` go, against the floor (the floor's 2 k + 2 pairs for k "
+                  "iterations; the fine level's pairs beyond 2 per iteration and the first K p and certificate "
+                  "are the fresh K p after each step whose projection moved p; `projections` part for the "
+                  "last column):", "", cascade_breakdown_table(rows, keys), "",
+                  "Reading: from the cascade start the fine level takes about the floor's iterations (within "
+                  "-3 and +5 at N >= 512); what is left over the floor is the fresh K p after projections and "
+                  "the coarse levels. The projections move a median of 49-470 nodes per step, and only 18-40 % "
+                  "of the moving steps move 16 nodes or fewer: shifted kernel copies (the "
+                  "prototype's point corrections, about one sweep of the grid per node) would save those few "
+                  "pairs only.", ""]
     lines += ["## 3. The edge-band preconditioner and its exact limit", "",
               "The `band<k>` floor columns of section 1 are the practical edge-band preconditioner. Other "
               "settings, the band's near-field matrix solved exactly (`-lu`), and the Schur form with the "
@@ -582,6 +843,41 @@ def report(rows):
     lines += [exact_band_table(rows) if rows_of(rows, "exactband") else "(not run)", ""]
     lines += ["## 4. Warm steps along the load history (7.11)", ""]
     lines += [warm_table(rows) if rows_of(rows, "warm") else "(not run)", ""]
+    if rows_of(rows, "warmfloor"):
+        lines += ["What limits a warm step (`warmfloor` part): after each step of today's solver along the "
+                  "history, CG on that step's own final contact set from a start predicted by the steps before "
+                  "it (the linear predictor today's solver uses, the quadratic through the last three "
+                  "solutions, the last solution alone), to the same certified residual. These runs are given "
+                  "the answer's contact set: they estimate from below what a warm step costs with this "
+                  "preconditioner from that start. Ratios are over the cold solve of the same case (today's pk, "
+                  "first table) and over the cold floor of section 1:", "", warm_floor_table(rows), "",
+                  "Reading: even given each step's final contact set, a warm step costs about 0.36 of a cold "
+                  "solve at N = 1024. The predicted start is off by a natural residual of about 5e-2 (the "
+                  "contact edge moves between the steps of (7.11), and no predictor tried starts closer: the "
+                  "quadratic one is no better than the linear one), and CG takes about 21 iterations to bring "
+                  "that to 1e-8 at the condition number 19 of section 1, 0.6 of the cold floor's 35. A warm "
+                  "step within 0.35 of a cold solve needs a better preconditioner on the contact set (item 3) "
+                  "or loads closer together; today's solver spends 0.52, 1.4 times the floor of its steps.", "",
+                  "![pairs per warm step](warm_floor.png)", ""]
+        plot_warm_floor(rows)
+    lines += ["## 5. Scaling against N", "",
+              "Today's solver (`pk`) and the prototype (`best`) against N, from the rows above (one run each "
+              "beside other work on the 2 shared cores: the seconds are noisy, and the rows of different N "
+              "come from different runs). Both converge with a count of pairs that grows slowly with N "
+              "(the floor's condition number grows like log N, section 1). Today's solver spends two pairs "
+              "per iteration (K t and the preconditioner) and one more at the start, one for the certificate, "
+              "and one to recompute K p afresh after every step whose projection moved p: the column 'besides "
+              "2 per iteration' is those, 17-31 % of the total at p* = 0.5 (growing with N); the rest of its excess over the floor "
+              "is iterations (61 against the floor's 40 at N = 4096, group 1, p* = 0.5).", "",
+              scaling_table(rows, keys), ""]
+    peers = peer_table()
+    if peers:
+        lines += [f"Against Tamaas ({peers[0]['started']}, `studies/output/peers.md`; group 1 with the peers' "
+                  "own generator, p* = 0.5, the same discrete surface and kernel for both, one process each, "
+                  "one run; both reach a natural residual of 1e-8 by our operator). Tamaas's iterations grow "
+                  "1.7-1.8x per doubling of N (about N^0.8), ours 1.1-1.2x:", "", peers[1], ""]
+    lines += ["The adhesive solver's cost against the non-adhesive one: `studies/output/adhesion/cost.md` "
+              "(N = 512).", ""]
     plot(rows, keys, floor_names, cold_names)
     lines += ["![floor and cold solves](solver_scaling.png)", "",
               "Regenerate (resumable; `--report` rewrites this file from the rows): see the module docstring of "
@@ -632,7 +928,8 @@ def main():
     parser.add_argument("--loads", type=float, nargs="*", default=[0.05, 0.5, 2.0])
     parser.add_argument("--groups", type=int, nargs="*", default=[1, 18])
     parser.add_argument("--parts", nargs="*", default=["reference", "pk", "floor", "cold"],
-                        choices=["reference", "pk", "floor", "cold", "slepc", "warm", "exactband", "gaps"])
+                        choices=["reference", "pk", "floor", "cold", "pkcascade", "projections", "slepc", "warm", "warmfloor", "exactband",
+                                 "gaps"])
     parser.add_argument("--widths", type=int, nargs="*", default=[1, 2, 4, 8],
                         help="band widths of the exactband diagnostic")
     parser.add_argument("--floor-pcs", nargs="*", default=["fourier", "band2"], choices=list(PRECONDITIONERS))
@@ -661,22 +958,33 @@ def main():
 
 def run_case(args, group, n, pstar, rows, path):
     key = case_key(group, n, pstar)
-    todo = {part for part in args.parts if part not in ("floor", "cold", "slepc", "warm")
+    todo = {part for part in args.parts if part not in ("floor", "cold", "slepc", "warm", "warmfloor", "pkcascade",
+                                                        "projections")
             and not has_row(rows, part, key, "pk" if part == "pk" else "pk 1e-12")}
+    if "pkcascade" in args.parts and not has_row(rows, "cold", key, "pk-cascade"):
+        todo.add("pkcascade")
+    if "projections" in args.parts and not has_row(rows, "projections", key, "cascade"):
+        todo.add("projections")
     floors = [name for name in args.floor_pcs if "floor" in args.parts and not has_row(rows, "floor", key, name)]
     colds = [name for name in args.cold if "cold" in args.parts and not has_row(rows, "cold", key, name)]
     slepcs = [name for name in args.floor_pcs if "slepc" in args.parts and not has_row(rows, "slepc", key, name)]
     warms = [name for name in args.warm if "warm" in args.parts and n == args.warm_n and pstar == 0.5
              and not has_row(rows, "warm", key, name)]
+    warm_floors = [name for name in args.floor_pcs if "warmfloor" in args.parts and n == args.warm_n
+                   and pstar == 0.5 and not has_row(rows, "warmfloor", key, name)]
     widths = [w for w in args.widths if "exactband" in args.parts and not has_row(rows, "exactband", key, f"width {w}")]
     gaps = "gaps" in args.parts and not has_row(rows, "gaps", key, "distance to C")
-    if not (todo or floors or colds or slepcs or warms or widths or gaps):
+    if not (todo or floors or colds or slepcs or warms or warm_floors or widths or gaps):
         return
     print(f"--- {key}", flush=True)
     problem = make_problem(group, n)
     try:
         if "pk" in todo:
             run_pk(problem, pstar, key, rows, path)
+        if "pkcascade" in todo:
+            run_pk_cascade(problem, pstar, key, rows, path)
+        if "projections" in todo:
+            run_projections(problem, pstar, key, rows, path)
         if floors or slepcs or widths or gaps or "reference" in todo:
             contact = reference_contact(problem, pstar, args.cache, key, rows, path)
         for name in floors:
@@ -691,6 +999,8 @@ def run_case(args, group, n, pstar, rows, path):
             run_cold(problem, pstar, key, name, rows, path)
         for name in warms:
             run_warm(problem, key, name, rows, path)
+        for name in warm_floors:
+            run_warm_floor(problem, key, name, rows, path)
     finally:
         problem.destroy()
 

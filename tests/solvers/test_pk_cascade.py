@@ -127,6 +127,27 @@ def test_lanczos_extremes_match_dense_eigenvalues_and_band_pc_is_spd(spec, top):
     assert eigenvalues[0] - 1e-12 <= low <= eigenvalues[0] * (1 + 1e-3)
 
 
+def test_fixed_set_pcg_from_a_start_certifies_on_the_exact_set():
+    """The warm floor's runs: from today's PK solution the certificate holds at once (the first K p and the
+    certificate's, 2 pairs); from that solution perturbed by 10 % node by node CG reaches the tolerance."""
+    problem = make_problem(32)
+    try:
+        pbar = problem.scaled_pbar(pstar=0.5)
+        expected = reference(problem, 0.5)
+        contact = expected > 0
+        level = pk_cascade.Level(heights(problem), 32, EFFORT)
+        preconditioner = pk_cascade.make_preconditioner(level, "fourier")
+        exact = pk_cascade.fixed_set_pcg(level, contact, pbar, preconditioner, 1e-8, start=expected)
+        noise = 1 + 0.1 * np.random.default_rng(5).uniform(-1, 1, expected.size)
+        perturbed = pk_cascade.fixed_set_pcg(level, contact, pbar, preconditioner, 1e-8, start=expected * noise)
+        level.destroy()
+    finally:
+        problem.destroy()
+    assert exact.iterations == 0 and exact.pairs == 2 and exact.certified <= 1e-8
+    assert perturbed.history[0] > 1e-3
+    assert perturbed.iterations > 0 and perturbed.certified <= 1e-8
+
+
 def test_point_responses_equal_the_compliance():
     level = pk_cascade.Level(np.zeros((16, 16)), 16, EFFORT)
     try:
