@@ -72,8 +72,8 @@ class PressureContinuation:
         """Put the start of a load-controlled solve at ``target`` in :attr:`pressure`; its K p if known.
 
         After two load-controlled solves, linear extrapolation in the load (step ratio capped at 2), projected
-        onto p >= 0; after one, that solution; with none, the pressure held (a displacement-controlled solution,
-        a resumed one) or from zero :attr:`cold_start`'s (if set and ``cold_start``), else uniform; then scaled to the new mean pressure.
+        onto p >= 0; after one, that solution; with none, the pressure put there (a resumed path's), or else
+        :attr:`cold_start`'s (if set and ``cold_start``), else uniform; then scaled to the new mean pressure.
         Returns K p of the start when the kept K p of the previous solutions give it exactly (one FFT pair
         saved per step), else None. Higher-order predictors started no closer (studies/load_history.py).
         """
@@ -106,9 +106,11 @@ class PressureContinuation:
             self.pressure.copy(self.previous)
             if known:
                 displacements[0].copy(self.start_displacement)
-        elif cold_start and self.cold_start is not None and self.pressure.norm(PETSc.NormType.INFINITY) == 0:
+        elif self.pressure.norm(PETSc.NormType.INFINITY) > 0:
+            known = False  # a start put in the pressure (a resumed path): its K p is computed by the backend
+        elif cold_start and self.cold_start is not None:
             self.cold_start(target, self.pressure)
-            known = False  # K p of this start is computed by the backend
+            known = False
         elif known:
             self.start_displacement.set(0.0)
         mean_p = self.pressure.sum() / self.problem.n

@@ -136,3 +136,29 @@ def test_parallel_cascade_equals_serial(tmp_path):
         assert steps[ranks]["cascade_applications"] == steps[1]["cascade_applications"] > 0
         assert steps[ranks]["A"] == steps[1]["A"]
         assert abs(steps[ranks]["gstar"] - steps[1]["gstar"]) <= 1e-12 * abs(steps[1]["gstar"])
+
+
+def test_a_start_put_in_the_pressure_is_solved_from_its_own_displacement():
+    """A resumed path puts its last pressure in the solver: the next step then costs what the same step costs
+    after that solve in one run (the same start, scaled to the load), plus the one pair of its K p. (Its K p
+    was once taken as zero, the uniform start's, which cost 13 more pairs at N = 256.)"""
+    problem = make_problem(64)
+    try:
+        solver = Solver(problem, "load", None, 1e-8)
+        try:
+            solver.solve(pstar=0.5)
+            saved = problem.local(solver.pressure, readonly=True).copy()
+            continued = solver.solve(pstar=0.6)
+        finally:
+            solver.destroy()
+        solver = Solver(problem, "load", None, 1e-8)
+        try:
+            problem.local(solver.pressure)[...] = saved
+            resumed = solver.solve(pstar=0.6)
+        finally:
+            solver.destroy()
+    finally:
+        problem.destroy()
+    assert continued.converged and resumed.converged
+    assert resumed.iterations == continued.iterations
+    assert resumed.operator_applications == continued.operator_applications + 1
