@@ -4,6 +4,7 @@ Hessian, fused callbacks) against Polonsky-Keer, a second algorithm, and their f
 import json
 import math
 import os
+import re
 import sys
 
 import numpy as np
@@ -78,8 +79,11 @@ def test_gpcg_under_load_converges_or_reports_the_residual_it_reached(reference)
         assert result.kkt.natural <= 1e-8 and result.kkt.load_error <= 1e-8
         assert np.abs(fields - pressure).max() <= 1e-6 * np.abs(pressure).max()
     else:
-        assert f"natural residual {result.kkt.natural:.1e}" in result.reason, result.reason
-        assert f"load error {result.kkt.load_error:.1e}" in result.reason, result.reason
+        # the reason quotes the certified figures to two digits ("1e-07" for 1.0e-07)
+        quoted = {name: float(value) for name, value in
+                  re.findall(r"(natural residual|load error) ([0-9.]+(?:e[-+]?[0-9]+)?)", result.reason)}
+        assert quoted["natural residual"] == pytest.approx(result.kkt.natural, rel=0.05), result.reason
+        assert quoted["load error"] == pytest.approx(result.kkt.load_error, rel=0.05), result.reason
         assert result.kkt.natural <= 1e-6  # a floor, not a divergence
         assert np.abs(fields - pressure).max() <= 1e-4 * np.abs(pressure).max()
 
