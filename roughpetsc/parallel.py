@@ -62,6 +62,13 @@ def gather_rows(comm, local):
     return np.concatenate(parts, axis=0) if comm.Get_rank() == 0 else None
 
 
+def allgather_rows(comm, local):
+    """The whole array on every rank from each rank's block of rows (mpi4py ``comm``)."""
+    if comm.Get_size() == 1:
+        return np.array(local)
+    return np.concatenate(comm.allgather(np.ascontiguousarray(local)), axis=0)
+
+
 def next_rank_first_row(comm, rows):
     """The first row of the next rank (periodically): the neighbour below this rank's last row."""
     size, rank = comm.Get_size(), comm.Get_rank()

@@ -108,22 +108,15 @@ COLD_VARIANTS = {
 
 
 # --- problems and the reference contact set ----------------------------------------------------------------
-def make_heights(group, n):
-    """The grid and heights of ``options/groupNN.opts`` at n x n (generator xu, seed 1)."""
-    from roughpetsc import Grid, fractal, fractal_group
-
-    preset = fractal_group(group)
-    grid = Grid(n, n, preset["length"], preset["length"])
-    return grid, fractal(grid, preset["k_l"], preset["k_s"], preset["hurst"], preset["m2"], seed=1, generator="xu")
-
-
 def make_problem(group, n):
     """The surface of ``options/groupNN.opts`` at n x n (generator xu, seed 1), E* = 1, one process."""
     from petsc4py import PETSc
 
-    from roughpetsc import ContactProblem
+    from roughpetsc import ContactProblem, Grid, fractal, fractal_group
 
-    grid, heights = make_heights(group, n)
+    preset = fractal_group(group)
+    grid = Grid(n, n, preset["length"], preset["length"])
+    heights = fractal(grid, preset["k_l"], preset["k_s"], preset["hurst"], preset["m2"], seed=1, generator="xu")
     return ContactProblem(grid, heights, 1.0, PETSc.COMM_SELF)
 
 

@@ -65,15 +65,15 @@ class PressureContinuation:
             self.pressure.set(0.0)
         if control == "displacement":
             return Guess()
-        return Guess(separation=self.last_separation, displacement=self.load_start(target, start != "uniform"),
-                     confirm=False)
+        displacement = self.load_start(target, use_cold_start=start != "uniform")
+        return Guess(separation=self.last_separation, displacement=displacement, confirm=False)
 
-    def load_start(self, target, cold_start=True):
+    def load_start(self, target, use_cold_start=True):
         """Put the start of a load-controlled solve at ``target`` in :attr:`pressure`; its K p if known.
 
         After two load-controlled solves, linear extrapolation in the load (step ratio capped at 2), projected
         onto p >= 0; after one, that solution; with none, the pressure put there (a resumed path's), or else
-        :attr:`cold_start`'s (if set and ``cold_start``), else uniform; then scaled to the new mean pressure.
+        :attr:`cold_start`'s (if set and ``use_cold_start``), else uniform; then scaled to the new mean pressure.
         Returns K p of the start when the kept K p of the previous solutions give it exactly (one FFT pair
         saved per step), else None. Higher-order predictors started no closer (studies/load_history.py).
         """
@@ -108,7 +108,7 @@ class PressureContinuation:
                 displacements[0].copy(self.start_displacement)
         elif self.pressure.norm(PETSc.NormType.INFINITY) > 0:
             known = False  # a start put in the pressure (a resumed path): its K p is computed by the backend
-        elif cold_start and self.cold_start is not None:
+        elif use_cold_start and self.cold_start is not None:
             self.cold_start(target, self.pressure)
             known = False
         elif known:

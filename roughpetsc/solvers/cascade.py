@@ -19,8 +19,8 @@ FFT pairs at p* = 0.05, 0.82-0.83 at p* = 0.5 and 1.00-1.03 at p* = 2; at N = 10
 0.97-0.99; at N = 512 0.93-1.11 (hence the default from N = 1024). From the cascade start the fine grid takes
 about the iterations of CG on the final contact set; what is left is the fresh K p after each projected step.
 
-Each coarse level is a :class:`~roughpetsc.ContactProblem` on the same communicator; the fine heights and
-each coarse solution are gathered on every rank (N^2 numbers each, for the injection and the interpolation
+Each coarse level is a :class:`~roughpetsc.ContactProblem` on the same communicator; its injected heights and
+its solution are gathered on every rank ((N / 2^k)^2 numbers each, for the coarse problem and the interpolation
 across rank boundaries), so parallel runs give the serial start exactly.
 """
 
@@ -28,6 +28,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..errors import UserError
+from ..parallel import allgather_rows
 from .stopping import option_name, read_option
 
 DEFAULT_RTOL = 1e-3
@@ -69,11 +70,6 @@ def prolong_bilinear_rows(coarse, rows):
     out[:, 0::2] = lines
     out[:, 1::2] = 0.5 * (lines + np.roll(lines, -1, axis=1))
     return out
-
-
-def gather_rows(mpi, local):
-    """The whole field from every rank's rows (ranks own consecutive rows in rank order)."""
-    return np.concatenate(mpi.allgather(np.ascontiguousarray(local)), axis=0)
 
 
 def cascade_settings(prefix=None):
@@ -148,14 +144,16 @@ class CascadeStart:
 
         problem = self.problem
         grid = problem.grid
-        heights = gather_rows(problem.mpi, problem.local(problem.heights, readonly=True)) * problem.height_scale
+        local = problem.local(problem.heights, readonly=True)
         pbar = target * problem.pressure_scale
         signed = None
         for factor in self.factors:
+            # The injected rows of this rank (global row a multiple of factor), gathered: (N / factor)^2 numbers.
+            injected = local[(-problem.local_rows.start) % factor::factor, ::factor]
+            heights = allgather_rows(problem.mpi, injected) * problem.height_scale
             # FFTW's estimate: measuring plans for grids solved once, to 1e-3, costs more than it saves
-            coarse = ContactProblem(Grid(grid.n0 // factor, grid.n1 // factor, grid.l0, grid.l1),
-                                    heights[::factor, ::factor], problem.E_star, problem.comm,
-                                    problem.fft_threads, "FFTW_ESTIMATE")
+            coarse = ContactProblem(Grid(grid.n0 // factor, grid.n1 // factor, grid.l0, grid.l1), heights,
+                                    problem.E_star, problem.comm, problem.fft_threads, "FFTW_ESTIMATE")
             try:
                 signed = self._solve_level(coarse, pbar, signed, factor)
             finally:
@@ -178,6 +176,6 @@ class CascadeStart:
             p = coarse.local(solver.pressure, readonly=True)
             gap = coarse.local(solver.work, readonly=True)
             signed = p - coarse.operator.stiffness_diagonal * np.maximum(gap, 0.0)
-            return gather_rows(coarse.mpi, signed)
+            return allgather_rows(coarse.mpi, signed)
         finally:
             solver.destroy()
