@@ -62,7 +62,9 @@ What is here
   Options kept for the record of what was measured worse (the study's variants): restarting CG when
   the free set changes by more than a fraction of its size (``restart_fraction``), interpolating p
   itself (``prolong="bilinear"``), spectral coarse heights, deferring the projection's corrections
-  (``lazy_until``, ``lazy_ratio``) and cutting the direction ahead of the projection (``clip_ahead``).
+  (``lazy_until``, ``lazy_ratio``) and cutting the direction ahead of the projection (``clip_ahead``); and the
+  projection's corrections by the split kernel (``near_radius``, ``far_ratio``, ``split_coarsening``,
+  ``refresh_ratio``: the prototype of ``-pk_split_radius``).
 
 Pairs are counted as the FFT pairs of every level weighted by its size, the certificate included. The
 prototype runs on one rank (the band's sparse matrices and the kernel copies are serial).
@@ -127,16 +129,8 @@ class Level:
         The kernel (one column of K) is computed by one FFT the first time (a set-up cost of the grid, not
         counted in :attr:`pairs`, like the FFTW plans).
         """
-        if self._kernel is None:
-            delta = np.zeros(self.size)
-            delta[0] = 1.0
-            self._kernel = np.empty(self.size)
-            self._in_array[...] = delta
-            self.operator.displacement(self._in, self._out)
-            self._kernel[...] = self._out_array
-            self._kernel = self._kernel.reshape(self.n, self.n)
         grid = out.reshape(self.n, self.n)
-        kernel = self._kernel
+        kernel = self._real_kernel()
         n = self.n
         for node, value in zip(nodes, values):
             i, j = divmod(int(node), n)
@@ -148,6 +142,77 @@ class Level:
                 grid[:i, j:] += value * kernel[n - i:, :n - j]
                 if j:
                     grid[:i, :j] += value * kernel[n - i:, n - j:]
+
+    def _real_kernel(self):
+        if self._kernel is None:
+            delta = np.zeros(self.size)
+            delta[0] = 1.0
+            self._in_array[...] = delta
+            self.operator.displacement(self._in, self._out)
+            self._kernel = self._out_array.copy().reshape(self.n, self.n)
+        return self._kernel
+
+    def near_window(self, radius):
+        """The kernel on the offsets ``|a|, |b| <= radius`` and the largest |K| outside them (the bound of the
+        far field of a unit load)."""
+        kernel = self._real_kernel()
+        offsets = np.arange(-radius, radius + 1) % self.n
+        window = kernel[np.ix_(offsets, offsets)].copy()
+        outside = np.abs(kernel).copy()
+        outside[np.ix_(offsets, offsets)] = 0.0
+        return window, float(outside.max())
+
+    def add_near_responses(self, nodes, values, out, radius):
+        """``out += K_near c``: the responses of point loads ``values`` at flat ``nodes`` within ``radius``
+        nodes (periodic), about (2 radius + 1)^2 operations per node, no FFT pair."""
+        window, _ = self.near_window(radius) if getattr(self, "_window_radius", None) != radius else \
+            (self._window, None)
+        self._window, self._window_radius = window, radius
+        grid = out.reshape(self.n, self.n)
+        offsets = np.arange(-radius, radius + 1)
+        for node, value in zip(nodes, values):
+            i, j = divmod(int(node), self.n)
+            grid[np.ix_((i + offsets) % self.n, (j + offsets) % self.n)] += value * window
+
+    def split_kernel(self, inner, outer, coarsening):
+        """The compliance kernel split smoothly at ``inner`` < r < ``outer`` nodes: ``K = K (1 - w) + K w``,
+        w the cubic step in r. Returns the near part on the offsets ``|a|, |b| <= outer`` and the rfft2 of the
+        far part sampled every ``coarsening`` nodes (smooth: no singularity, so sampling it coarsely and
+        interpolating bilinearly costs O((coarsening / inner)^2) of its value)."""
+        kernel = self._real_kernel()
+        n = self.n
+        offsets = np.minimum(np.arange(n), n - np.arange(n)).astype(float)
+        r = np.hypot(offsets[:, None], offsets[None, :])
+        step = np.clip((r - inner) / (outer - inner), 0.0, 1.0)
+        far = kernel * step * step * (3.0 - 2.0 * step)
+        window = np.arange(-outer, outer + 1) % n
+        near = (kernel - far)[np.ix_(window, window)].copy()
+        return near, np.fft.rfft2(far[::coarsening, ::coarsening])
+
+    def add_split_responses(self, nodes, values, out, split, outer, coarsening):
+        """``out += K c`` for point loads c: the near part exactly by the stencil, the far part by one FFT
+        pair on the grid coarsened by ``coarsening`` (counted as ``coarsening^-2`` pairs) between the
+        bilinear restriction of c and the bilinear interpolation of its response."""
+        near, far_hat = split
+        n, s = self.n, coarsening
+        m = n // s
+        grid = out.reshape(n, n)
+        stencil = np.arange(-outer, outer + 1)
+        rows, cols = np.divmod(np.asarray(nodes, dtype=np.int64), n)
+        for i, j, value in zip(rows, cols, values):
+            grid[np.ix_((i + stencil) % n, (j + stencil) % n)] += value * near
+        coarse = np.zeros((m, m))
+        fy, fx = (rows % s) / s, (cols % s) / s
+        y0, x0 = rows // s, cols // s
+        for dy, wy in ((0, 1.0 - fy), (1, fy)):
+            for dx, wx in ((0, 1.0 - fx), (1, fx)):
+                np.add.at(coarse, ((y0 + dy) % m, (x0 + dx) % m), values * wy * wx)
+        response = np.fft.irfft2(np.fft.rfft2(coarse) * far_hat, s=(m, m))
+        self.pairs += 1.0 / (s * s)
+        frac = (np.arange(n) % s) / s
+        low, high = np.arange(n) // s, (np.arange(n) // s + 1) % m
+        rows_interp = (1.0 - frac)[:, None] * response[low] + frac[:, None] * response[high]
+        grid += (1.0 - frac)[None, :] * rows_interp[:, low] + frac[None, :] * rows_interp[:, high]
 
     def stiffness(self, x, out):
         """``out = S x``, S the symbol ``pi max(|k|, 1)`` (the preconditioner's inverse compliance): one pair."""
@@ -546,6 +611,10 @@ class CascadeOptions:
     lazy_until: float = np.inf
     lazy_ratio: float = 0.0
     clip_ahead: float = 0.0
+    near_radius: int = 0
+    far_ratio: float = 0.0
+    split_coarsening: int = 0
+    refresh_ratio: float = 0.0
 
 
 class CascadePK:
@@ -585,6 +654,15 @@ class CascadePK:
         0: the step is projected (and a pair corrects K p when that moved p). c > 0: before ``K t`` the
         direction is cut at the nodes that a step of c times the previous step length would drive
         negative (so they land on zero), and the step is capped there: the projection never acts.
+    near_radius : int
+        > 0: the projection's corrections c go into K p as ``K c`` split at this many nodes: the near part
+        by the kernel's stencil at once (no pair), and the far part by a pair when its bound
+        ``max|K_far| sum(c)`` passes ``far_ratio`` times the residual (or at the end); with
+        ``split_coarsening`` instead, the far part at once on the grid coarsened that many times
+        (``Level.add_split_responses``, roughpetsc.elastic.split in the solver) and K p afresh each time the
+        residual has fallen by ``refresh_ratio`` (0: only for the certificate).
+    far_ratio, split_coarsening, refresh_ratio : float, int, float
+        See ``near_radius``.
     """
 
     def __init__(self, heights, effort="FFTW_MEASURE", **options):
@@ -645,6 +723,15 @@ class CascadePK:
             p = prolong_bilinear(p_coarse.reshape(m, m)).ravel()
         return p * (fine.size * pbar / p.sum())
 
+    @staticmethod
+    def _apply_far(level, far_pending, work, u, radius):
+        """``u += (K - K_near) c`` for the pending corrections c: one pair."""
+        level.compliance(far_pending, work)
+        u += work
+        nodes = np.flatnonzero(far_pending)
+        level.add_near_responses(nodes, -far_pending[nodes], u, radius)
+        far_pending[...] = 0.0
+
     def _level_solve(self, level, p, u, pbar, rtol, certify):
         """Projected PCG on one level from ``p`` (mean pbar); returns ``(p, gap, LevelSolve)``."""
         size = level.size
@@ -656,6 +743,12 @@ class CascadePK:
             level.compliance(p, u)
         q, z, t, r, r_old = (np.zeros(size) for _ in range(5))
         pending = np.zeros(size)  # projection corrections not yet applied to u = K (p - pending)
+        far_pending = np.zeros(size)  # corrections whose near field is in u but not their far field
+        radius = self.options.near_radius
+        coarsening = self.options.split_coarsening if level.n >= 4 * self.options.split_coarsening else 0
+        split = level.split_kernel(radius // 2, radius, coarsening) if radius and coarsening else None
+        far_bound = level.near_window(radius)[1] if radius and not split else 0.0
+        approximated, refreshed_at = False, np.inf
         alpha_previous = None
         free_previous = None
         rz_old = 1.0
@@ -666,6 +759,17 @@ class CascadePK:
             d = contact_separation(p, elastic, contact)
             gap = elastic + d
             natural = natural_residual(p, gap, pbar)
+            if split is not None and self.options.refresh_ratio and approximated and \
+                    (natural <= rtol or natural < self.options.refresh_ratio * refreshed_at):
+                level.compliance(p, u)  # the split corrections' errors, cleared by a fresh K p
+                approximated = False
+                refreshed_at = natural
+                record.corrections += 1
+                continue
+            if natural <= rtol and far_pending.any():
+                self._apply_far(level, far_pending, z, u, radius)
+                record.corrections += 1
+                continue
             if natural <= rtol and pending.any():
                 level.compliance(pending, z)
                 u += z
@@ -724,6 +828,21 @@ class CascadePK:
             fresh = False
             clipped = int(np.count_nonzero(p != trial))
             record.trace.append((count, changed, clipped, bool(restart)))
+            if clipped and split is not None:
+                nodes = np.flatnonzero(pending)
+                level.add_split_responses(nodes, pending[nodes], u, split, radius, coarsening)
+                approximated = True
+                pending[...] = 0.0
+                record.point_corrections += 1
+            elif clipped and radius:
+                nodes = np.flatnonzero(pending)
+                level.add_near_responses(nodes, pending[nodes], u, radius)
+                far_pending[nodes] += pending[nodes]
+                pending[...] = 0.0
+                record.point_corrections += 1
+                if far_bound * far_pending.sum() > self.options.far_ratio * natural:
+                    self._apply_far(level, far_pending, z, u, radius)
+                    record.corrections += 1
             # |K pending|_inf <= K_00 sum(pending): the gap error of skipping the correction, against the residual
             if clipped and natural <= self.options.lazy_until and \
                     level.diagonal * pending.sum() > self.options.lazy_ratio * natural:
@@ -740,6 +859,7 @@ class CascadePK:
             p *= factor
             u *= factor
             pending *= factor
+            far_pending *= factor
             record.iterations = iteration + 1
         record.pairs = level.pairs - start_pairs
         record.natural = natural

@@ -17,8 +17,11 @@ command line's default seed 1, i.e. the surface of
 Parts (``--parts``):
 
 - ``reference``: today's default solver (Polonsky-Keer, BCCG active set, Fourier preconditioner) to a natural
-  residual of 1e-12. Its contact set {p > 0} is *the exact final contact set* C (kept as a bit mask in
-  ``--cache``, outside the repository).
+  residual of ``--reference-rtol`` (1e-12). Its contact set {p > 0} is *the exact final contact set* C (kept
+  as a bit mask in ``--cache``, outside the repository). At N = 4096 a 1e-12 reference stopped at round-off
+  (2.8e-12) after 1637 pairs, and a pair at N = 8192 takes 4-6 s here, so those cases take 1e-10: the floor run certifies
+  the set it is given (its natural residual on the whole grid is 1e-8 only if C is the final set to that
+  tolerance), and the ``refcheck`` cases show that the floor does not depend on the reference tolerance.
 - ``pk``: today's default solver, cold from the uniform pressure (``-cascade_coarsest 0``), to 1e-8
   (``common.solve``: the Solver facade, its certificate included): iterations, FFT pairs
   (``operator.applications``), seconds.
@@ -38,6 +41,9 @@ Parts (``--parts``):
 - ``pkcascade``: today's solver from the cascade start (``-cascade_coarsest 256``,
   :mod:`roughpetsc.solvers.cascade`), cold, to 1e-8: the ``pk-cascade`` column of the cold table, its coarse
   pairs weighted by (N_c / N)^2.
+- ``pksplit``: today's solver with the projection's corrections by the split compliance
+  (``-pk_split_radius 32``, :mod:`roughpetsc.elastic.split`), cascade start at N >= 1024: the ``pk-split``
+  column, its coarse pairs (cascade levels and far fields) weighted; timed beside ``-pk_split_radius 0``.
 - ``projections``: how many nodes each projected step of today's solver moves, from the uniform and the
   cascade start (:func:`run_projections`).
 - ``slepc``: the Lanczos estimates checked against SLEPc (Krylov-Schur on ``B P K_CC P``, the constant on
@@ -104,6 +110,21 @@ COLD_VARIANTS = {
                        preconditioner=PRECONDITIONERS["band2"], point_corrections=16),
     "best-band3": dict(cascade="auto", coarsest=256, restart_fraction=_NEVER, prolong="signed",
                        preconditioner=PRECONDITIONERS["band3"], point_corrections=16),
+    # The fresh K p after a projection split in two: its near field (offsets up to 16 nodes) added at once by
+    # the real-space kernel (no pair), its far field by one pair only when its bound max|K_far| sum(c) passes
+    # far_ratio times the residual (`near16`), or only at the end (`near16-deferred`); `cascade-fourier` is
+    # the same cascade with every correction by a pair.
+    "cascade-fourier": dict(_PLAIN, cascade="auto", coarsest=256, prolong="signed"),
+    "near16": dict(_PLAIN, cascade="auto", coarsest=256, prolong="signed", near_radius=16, far_ratio=1.0),
+    "near16-deferred": dict(_PLAIN, cascade="auto", coarsest=256, prolong="signed", near_radius=16,
+                            far_ratio=_NEVER),
+    # The split kept whole: the far field on the grid coarsened 4 times at once (1/16 pair), and a fresh K p
+    # when the residual has fallen 100 times since the last (`split32`, what -pk_split_radius 32 does), or never
+    # before the certificate (`split32-norefresh`).
+    "split32": dict(_PLAIN, cascade="auto", coarsest=256, prolong="signed", near_radius=32, split_coarsening=4,
+                    refresh_ratio=1e-2),
+    "split32-norefresh": dict(_PLAIN, cascade="auto", coarsest=256, prolong="signed", near_radius=32,
+                              split_coarsening=4),
 }
 
 
@@ -124,30 +145,40 @@ def case_key(group, n, pstar):
     return f"g{group:02d}_N{n}_p{pstar:g}"
 
 
-def contact_path(cache, key):
-    return os.path.join(cache, key + ".contact.npz")
+REFERENCE_RTOL = 1e-12
 
 
-def reference_contact(problem, pstar, cache, key, rows, path):
-    """The exact final contact set of the case (bool, flat): from the cache, or by today's solver to 1e-12."""
-    file = contact_path(cache, key)
+def reference_variant(rtol):
+    return f"pk {rtol:g}"
+
+
+def contact_path(cache, key, rtol):
+    suffix = "" if rtol == REFERENCE_RTOL else f"_ref{rtol:g}"
+    return os.path.join(cache, key + suffix + ".contact.npz")
+
+
+def reference_contact(problem, pstar, cache, key, rows, path, rtol=REFERENCE_RTOL):
+    """The exact final contact set of the case (bool, flat): from the cache, or by today's solver to ``rtol``."""
+    file = contact_path(cache, key, rtol)
     if os.path.exists(file):
         with np.load(file) as saved:
             return np.unpackbits(saved["bits"], count=problem.n).astype(bool)
-    result, pressure, seconds = common.solve(problem, {}, 1e-12, pstar=pstar)
+    result, pressure, seconds = common.solve(problem, {"pk_split_radius": 0}, rtol, pstar=pstar)
     contact = pressure.ravel() > 0
     os.makedirs(cache, exist_ok=True)
     np.savez(file + ".partial.npz", bits=np.packbits(contact))
     os.replace(file + ".partial.npz", file)
-    add_row(rows, path, dict(part="reference", key=key, variant="pk 1e-12", iterations=result.iterations,
+    add_row(rows, path, dict(part="reference", key=key, variant=reference_variant(rtol), iterations=result.iterations,
                              pairs=result.operator_applications, natural=result.kkt.natural, A=result.A,
                              contact=int(contact.sum()), converged=result.converged, seconds=seconds))
     return contact
 
 
 # --- rows -------------------------------------------------------------------------------------------------
-def has_row(rows, part, key, variant):
-    return any(r["part"] == part and r["key"] == key and r["variant"] == variant for r in rows)
+def has_row(rows, part, key, variant, **fields):
+    return any(r["part"] == part and r["key"] == key and r["variant"] == variant
+               and all(r.get(k, REFERENCE_RTOL if k == "reference" else None) == v for k, v in fields.items())
+               for r in rows)
 
 
 def add_row(rows, path, row):
@@ -163,7 +194,7 @@ def parse_key(key):
 
 # --- parts ------------------------------------------------------------------------------------------------
 def run_pk(problem, pstar, key, rows, path):
-    result, _, seconds = common.solve(problem, {"cascade_coarsest": 0}, RTOL, pstar=pstar)
+    result, _, seconds = common.solve(problem, {"cascade_coarsest": 0, "pk_split_radius": 0}, RTOL, pstar=pstar)
     add_row(rows, path, dict(part="pk", key=key, variant="pk", iterations=result.iterations,
                              pairs=result.operator_applications, natural=result.kkt.natural,
                              converged=result.converged, seconds=seconds))
@@ -173,7 +204,7 @@ def fine_heights(problem):
     return problem.local(problem.heights, readonly=True).copy()
 
 
-def run_floor(problem, pstar, contact, key, name, rows, path):
+def run_floor(problem, pstar, contact, key, name, rows, path, reference=REFERENCE_RTOL):
     import pk_cascade
 
     n = problem.grid.n0
@@ -189,7 +220,8 @@ def run_floor(problem, pstar, contact, key, name, rows, path):
         level.destroy()
     add_row(rows, path, dict(part="floor", key=key, variant=name, pairs=run.pairs, iterations=run.iterations,
                              certified=run.certified, lambda_min=low, lambda_max=high, cond=high / low,
-                             lanczos_steps=steps, contact=int(contact.sum()), seconds=seconds))
+                             lanczos_steps=steps, contact=int(contact.sum()), reference=reference,
+                             seconds=seconds))
 
 
 def certify(problem, pressure, separation, pbar):
@@ -230,28 +262,55 @@ def run_cold(problem, pstar, key, name, rows, path):
                              levels=levels, seconds=seconds, setup_seconds=setup))
 
 
+def paired_solves(problem, pstar, option_sets):
+    """One cold solve per set of solver options, one after the other in this run: ``[(Result, seconds)]``."""
+    from roughpetsc import Solver
+
+    measured = []
+    for options in option_sets:
+        solver = Solver(problem, "load", None, RTOL, options=options)
+        try:
+            start = time.perf_counter()
+            measured.append((solver.solve(pstar=pstar), time.perf_counter() - start))
+        finally:
+            solver.destroy()
+    return measured
+
+
 def run_pk_cascade(problem, pstar, key, rows, path, coarsest=256):
     """Today's solver from the cascade start (:mod:`roughpetsc.solvers.cascade`, ``-cascade_coarsest``), the
     variant ``pk-cascade`` of the cold table: the fine grid's pairs (its certificate included) plus the coarse
     levels' weighted by (N_c / N)^2; timed beside a solve from the uniform start in the same run (the coarse
     grids' set-up and FFTW plans inside the cascade's time)."""
-    from roughpetsc import Solver
-
-    measured = {}
-    for name, value in (("uniform", 0), ("cascade", coarsest)):  # paired: the same run times both starts
-        solver = Solver(problem, "load", None, RTOL, options={"cascade_coarsest": value})
-        try:
-            start = time.perf_counter()
-            measured[name] = (solver.solve(pstar=pstar), time.perf_counter() - start)
-        finally:
-            solver.destroy()
-    (uniform, uniform_seconds), (result, seconds) = measured["uniform"], measured["cascade"]
+    # paired: the same run times both starts
+    (uniform, uniform_seconds), (result, seconds) = paired_solves(
+        problem, pstar, [{"cascade_coarsest": 0, "pk_split_radius": 0},
+                         {"cascade_coarsest": coarsest, "pk_split_radius": 0}])
     add_row(rows, path, dict(part="cold", key=key, variant="pk-cascade",
                              pairs=result.operator_applications + result.cascade_applications,
                              fine_pairs=result.operator_applications, coarse_pairs=result.cascade_applications,
                              iterations=result.iterations, natural=result.kkt.natural,
                              converged=bool(result.converged and uniform.converged), seconds=seconds,
                              uniform_pairs=uniform.operator_applications, uniform_seconds=uniform_seconds))
+
+
+def run_pk_split(problem, pstar, key, rows, path):
+    """Today's solver with ``-pk_split_radius 32``, the variant ``pk-split`` of the cold table: the cascade
+    start where it is the default (N >= 1024) and the projection's corrections by the split compliance
+    (:mod:`roughpetsc.elastic.split`); pairs = the grid's (the split's set-up pair and the certificate
+    included) + the coarse levels' + the split's coarse far fields', each weighted by its grid's size. Timed
+    beside the solver without the split (``-pk_split_radius 0``) in the same run."""
+    (fresh, fresh_seconds), (result, seconds) = paired_solves(
+        problem, pstar, [{"pk_split_radius": 0}, {"pk_split_radius": 32}])
+    add_row(rows, path, dict(part="cold", key=key, variant="pk-split",
+                             pairs=result.operator_applications + result.cascade_applications
+                             + result.split_applications,
+                             fine_pairs=result.operator_applications, coarse_pairs=result.cascade_applications,
+                             split_pairs=result.split_applications,
+                             iterations=result.iterations, natural=result.kkt.natural,
+                             converged=bool(result.converged and fresh.converged), seconds=seconds,
+                             fresh_pairs=fresh.operator_applications + fresh.cascade_applications,
+                             fresh_seconds=fresh_seconds))
 
 
 def run_projections(problem, pstar, key, rows, path, coarsest=256):
@@ -273,7 +332,7 @@ def run_projections(problem, pstar, key, rows, path, coarsest=256):
 
     for name, value in (("uniform", 0), ("cascade", coarsest)):
         loops.take_step = counting_step
-        solver = Solver(problem, "load", None, RTOL, options={"cascade_coarsest": value})
+        solver = Solver(problem, "load", None, RTOL, options={"cascade_coarsest": value, "pk_split_radius": 0})
         try:
             moved.clear()
             result = solver.solve(pstar=pstar)
@@ -562,8 +621,13 @@ def rows_of(rows, part):
     return [r for r in rows if r["part"] == part]
 
 
+def by_reference(found):
+    """Rows of one measurement, the one on the tightest reference contact set last."""
+    return sorted(found, key=lambda r: -r.get("reference", REFERENCE_RTOL))
+
+
 def lookup(rows, part, key, variant, field="pairs"):
-    found = [r for r in rows if r["part"] == part and r["key"] == key and r["variant"] == variant]
+    found = by_reference([r for r in rows if r["part"] == part and r["key"] == key and r["variant"] == variant])
     return found[-1][field] if found else None
 
 
@@ -572,22 +636,38 @@ def fmt(value, spec=".0f"):
 
 
 def floor_table(rows, keys, floor_names):
-    header = ["group", "p*", "N", "|C|/N^2"] + [f"{n} pairs" for n in floor_names] + \
+    header = ["group", "p*", "N", "reference", "|C|/N^2"] + [f"{n} pairs" for n in floor_names] + \
              [f"{n} lambda_min / lambda_max (cond)" for n in floor_names]
     table = []
     for key in keys:
         group, n, pstar = parse_key(key)
-        floor = {name: [r for r in rows_of(rows, "floor") if r["key"] == key and r["variant"] == name]
+        floor = {name: by_reference([r for r in rows_of(rows, "floor") if r["key"] == key and r["variant"] == name])
                  for name in floor_names}
         if not any(floor.values()):
             continue
         first = next(v[-1] for v in floor.values() if v)
-        row = [group, f"{pstar:g}", n, f"{first['contact'] / n ** 2:.3f}"]
+        row = [group, f"{pstar:g}", n, f"{first.get('reference', REFERENCE_RTOL):g}",
+               f"{first['contact'] / n ** 2:.3f}"]
         row += [fmt(v[-1]["pairs"], "d") if v else "-" for v in floor.values()]
         row += [f"{v[-1]['lambda_min']:.3f} / {v[-1]['lambda_max']:.2f} ({v[-1]['cond']:.2f})" if v else "-"
                 for v in floor.values()]
         table.append(row)
     return common.markdown_table(header, table)
+
+
+def refcheck_table(rows):
+    """Floor runs of one case on the reference sets of both tolerances, side by side."""
+    table = []
+    for loose in [r for r in rows_of(rows, "floor") if r.get("reference", REFERENCE_RTOL) != REFERENCE_RTOL]:
+        tight = [r for r in rows_of(rows, "floor") if r["key"] == loose["key"] and r["variant"] == loose["variant"]
+                 and r.get("reference", REFERENCE_RTOL) == REFERENCE_RTOL]
+        if tight:
+            t = tight[-1]
+            table.append([loose["key"], loose["variant"], t["contact"], loose["contact"], t["pairs"], loose["pairs"],
+                          f"{t['cond']:.3f}", f"{loose['cond']:.3f}"])
+    return common.markdown_table(["case", "pc", "|C| (1e-12)", f"|C| ({loose['reference']:g})", "pairs (1e-12)",
+                                  f"pairs ({loose['reference']:g})", "cond (1e-12)", f"cond ({loose['reference']:g})"],
+                                 table)
 
 
 def slepc_table(rows):
@@ -645,6 +725,49 @@ def cascade_breakdown_table(rows, keys):
          "steps that moved p / of them at most 16 nodes / median nodes moved"], table)
 
 
+def split_table(rows, keys):
+    """``pk-split`` against the floor and against the same solver with a fresh K p (pairs and wall time)."""
+    table = []
+    for key in keys:
+        found = [r for r in rows_of(rows, "cold") if r["key"] == key and r["variant"] == "pk-split"]
+        floor = lookup(rows, "floor", key, "fourier")
+        if not found or floor is None:
+            continue
+        r = found[-1]
+        group, n, pstar = parse_key(key)
+        table.append([group, f"{pstar:g}", n, floor, r["iterations"], f"{r['fine_pairs']}",
+                      f"{r['coarse_pairs']:.1f}", f"{r['split_pairs']:.2f}", f"{r['pairs']:.1f}",
+                      f"{r['pairs'] / floor:.2f}", f"{r['fresh_pairs']:.1f}", f"{r['fresh_pairs'] / floor:.2f}",
+                      f"{r['seconds'] / r['fresh_seconds']:.2f}", "yes" if r["converged"] else "NO"])
+    return common.markdown_table(["group", "p*", "N", "floor pairs", "iterations", "grid pairs", "cascade pairs",
+                                  "far-field pairs", "pk-split pairs", "/ floor", "fresh pairs", "/ floor",
+                                  "wall split / fresh", "certified"], table)
+
+
+def split_reading(rows, keys):
+    """The split table in words: its ratio to the floor with and without the cascade start, and its wall time."""
+    cases = []
+    for key in keys:
+        found = [r for r in rows_of(rows, "cold") if r["key"] == key and r["variant"] == "pk-split"]
+        floor = lookup(rows, "floor", key, "fourier")
+        if found and floor:
+            cases.append((parse_key(key), found[-1]["pairs"] / floor, found[-1]["seconds"] / found[-1]["fresh_seconds"]))
+    if not cases:
+        return ""
+    large = [ratio for (_, n, _), ratio, _ in cases if n >= 1024]
+    small = [ratio for (_, n, _), ratio, _ in cases if n < 1024]
+    over = [f"group {g} p* = {p:g} N = {n} ({ratio:.2f})" for (g, n, p), ratio, _ in cases if ratio > 1.3]
+    walls = np.array([wall for _, _, wall in cases])
+    return (f"Reading: with the split the cold solve costs {min(large):.2f}-{max(large):.2f}x the floor at N >= 1024 "
+            f"(cascade start) and {min(small):.2f}-{max(small):.2f}x at N < 1024 (uniform start, where a step "
+            f"clipping more than the stencil's work allows takes a fresh K p); over 1.3x: {', '.join(over) or 'none'}. "
+            f"The coarse levels of the cascade are now the larger part of what is left at N >= 1024. Wall time "
+            f"over the fresh solve's, in the same runs: {walls.min():.2f}-{walls.max():.2f} (median "
+            f"{np.median(walls):.2f}): the stencil ((2R + 1)^2 operations per corrected node, memory-bound) and "
+            f"the far field's interpolation cost about what the pairs saved, so the split is an option "
+            f"(`-pk_split_radius 32`), not the default.")
+
+
 def timing_table(rows, keys, cold_names):
     timing = []
     for key in keys:
@@ -655,7 +778,8 @@ def timing_table(rows, keys, cold_names):
         for name in cold_names:
             seconds = lookup(rows, "cold", key, name, "seconds")
             # pk-cascade is timed beside a uniform start of its own run (paired)
-            reference = lookup(rows, "cold", key, name, "uniform_seconds") if name == "pk-cascade" else pk_seconds
+            paired_field = {"pk-cascade": "uniform_seconds", "pk-split": "fresh_seconds"}.get(name)
+            reference = lookup(rows, "cold", key, name, paired_field) if paired_field else pk_seconds
             cells.append(fmt(seconds / reference, ".2f") if seconds else "-")
         timing.append([key] + cells)
     return common.markdown_table(["case"] + cold_names, timing)
@@ -780,7 +904,7 @@ def peer_table():
 def report(rows):
     keys = sorted({r["key"] for r in rows}, key=lambda k: (parse_key(k)[0], parse_key(k)[2], parse_key(k)[1]))
     floor_names = [n for n in PRECONDITIONERS if any(r["variant"] == n for r in rows_of(rows, "floor"))]
-    cold_names = [n for n in list(COLD_VARIANTS) + ["pk-cascade"] if any(r["variant"] == n for r in rows_of(rows, "cold"))]
+    cold_names = [n for n in list(COLD_VARIANTS) + ["pk-cascade", "pk-split"] if any(r["variant"] == n for r in rows_of(rows, "cold"))]
     lines = ["# The contact solver's floor, cold solves against it, and warm load steps (issue 39, items 1-4)", "",
              "Written by `studies/solver_scaling.py` from its `rows*.json` (its docstring defines every quantity; "
              "`studies/pk_cascade.py` describes the prototype solver step by step). FFT pairs and "
@@ -797,6 +921,12 @@ def report(rows):
              "subspace of C, from the Lanczos matrix of the CG coefficients (CG run on to a reduction of "
              "1e-10; Ritz values lie inside the spectrum, so lambda_max is a lower and lambda_min an upper "
              "estimate).", "", floor_table(rows, keys, [n for n in floor_names if n in MAIN_PRECONDITIONERS]), ""]
+    if any(r.get("reference", REFERENCE_RTOL) != REFERENCE_RTOL for r in rows_of(rows, "floor")):
+        lines += ["The reference contact set at N = 8192 comes from a solve to 1e-10 (column `reference`; at N = 4096 "
+                  "a 1e-12 one stopped at round-off, 2.8e-12, after 1637 pairs, and a pair at 8192 takes 4-6 s "
+                  "here). Where both exist, the two "
+                  "references give the same set and the same floor (`--reference-rtol 1e-10`, rows_refcheck):",
+                  "", refcheck_table(rows), ""]
     if rows_of(rows, "slepc"):
         lines += ["SLEPc cross-check (Krylov-Schur, tolerance 1e-8, the constant on C deflated):", "",
                   slepc_table(rows), ""]
@@ -825,6 +955,19 @@ def report(rows):
                   "of the moving steps move 16 nodes or fewer: shifted kernel copies (the "
                   "prototype's point corrections, about one sweep of the grid per node) would save those few "
                   "pairs only.", ""]
+    if any(r["variant"] == "pk-split" for r in rows_of(rows, "cold")):
+        lines += ["### The fresh K p after projections, replaced: the split compliance", "",
+                  "`pk-split` is today's solver with `-pk_split_radius 32` (`roughpetsc/elastic/split.py`): "
+                  "after a step the projection moved, K c of its corrections c is added by a stencil of the "
+                  "kernel's near part (offsets up to 32 nodes, split smoothly from 16) and the smooth far part "
+                  "on the grid coarsened 4 times (1/16 pair), and K p is computed afresh each time the residual "
+                  "has fallen 100 times since the last. The prototype's variants at N = 1024 say why each part "
+                  "is there (cold table): `near16-deferred` (far field never applied before the end) doubles the "
+                  "iterations, `split32-norefresh` (applied to 0.05-0.3 % but never refreshed) loses many, "
+                  "`split32` does not. Pairs below count the grid's (the split's set-up pair, the refreshes and "
+                  "the certificate included), the cascade levels' and the far fields', weighted; `fresh` is the "
+                  "same solve with `-pk_split_radius 0` (a fresh K p after every moving step), timed in the same "
+                  "run:", "", split_table(rows, keys), "", split_reading(rows, keys), ""]
     lines += ["## 3. The edge-band preconditioner and its exact limit", "",
               "The `band<k>` floor columns of section 1 are the practical edge-band preconditioner. Other "
               "settings, the band's near-field matrix solved exactly (`-lu`), and the Schur form with the "
@@ -929,7 +1072,7 @@ def main():
     parser.add_argument("--loads", type=float, nargs="*", default=[0.05, 0.5, 2.0])
     parser.add_argument("--groups", type=int, nargs="*", default=[1, 18])
     parser.add_argument("--parts", nargs="*", default=["reference", "pk", "floor", "cold"],
-                        choices=["reference", "pk", "floor", "cold", "pkcascade", "projections", "slepc", "warm", "warmfloor", "exactband",
+                        choices=["reference", "pk", "floor", "cold", "pkcascade", "pksplit", "projections", "slepc", "warm", "warmfloor", "exactband",
                                  "gaps"])
     parser.add_argument("--widths", type=int, nargs="*", default=[1, 2, 4, 8],
                         help="band widths of the exactband diagnostic")
@@ -938,6 +1081,8 @@ def main():
                         choices=list(COLD_VARIANTS))
     parser.add_argument("--warm", nargs="*", default=["pk", "cascade-band2"], choices=["pk"] + list(COLD_VARIANTS))
     parser.add_argument("--warm-n", type=int, default=1024, help="grid of the warm-step part (at p* = 0.5)")
+    parser.add_argument("--reference-rtol", type=float, default=REFERENCE_RTOL,
+                        help="natural residual of the reference solve whose contact set the floor runs on")
     parser.add_argument("--cache", default=os.path.expanduser("~/.cache/roughpetsc/solver_scaling"),
                         help="folder of the reference contact sets (bit masks)")
     parser.add_argument("--rows", default="rows", help="the rows file (OUT/NAME.json) this run adds to, so that "
@@ -960,13 +1105,16 @@ def main():
 def run_case(args, group, n, pstar, rows, path):
     key = case_key(group, n, pstar)
     todo = {part for part in args.parts if part not in ("floor", "cold", "slepc", "warm", "warmfloor", "pkcascade",
-                                                        "projections")
-            and not has_row(rows, part, key, "pk" if part == "pk" else "pk 1e-12")}
+                                                        "projections", "pksplit")
+            and not has_row(rows, part, key, "pk" if part == "pk" else reference_variant(args.reference_rtol))}
     if "pkcascade" in args.parts and not has_row(rows, "cold", key, "pk-cascade"):
         todo.add("pkcascade")
+    if "pksplit" in args.parts and not has_row(rows, "cold", key, "pk-split"):
+        todo.add("pksplit")
     if "projections" in args.parts and not has_row(rows, "projections", key, "cascade"):
         todo.add("projections")
-    floors = [name for name in args.floor_pcs if "floor" in args.parts and not has_row(rows, "floor", key, name)]
+    floors = [name for name in args.floor_pcs if "floor" in args.parts
+              and not has_row(rows, "floor", key, name, reference=args.reference_rtol)]
     colds = [name for name in args.cold if "cold" in args.parts and not has_row(rows, "cold", key, name)]
     slepcs = [name for name in args.floor_pcs if "slepc" in args.parts and not has_row(rows, "slepc", key, name)]
     warms = [name for name in args.warm if "warm" in args.parts and n == args.warm_n and pstar == 0.5
@@ -984,12 +1132,14 @@ def run_case(args, group, n, pstar, rows, path):
             run_pk(problem, pstar, key, rows, path)
         if "pkcascade" in todo:
             run_pk_cascade(problem, pstar, key, rows, path)
+        if "pksplit" in todo:
+            run_pk_split(problem, pstar, key, rows, path)
         if "projections" in todo:
             run_projections(problem, pstar, key, rows, path)
         if floors or slepcs or widths or gaps or "reference" in todo:
-            contact = reference_contact(problem, pstar, args.cache, key, rows, path)
+            contact = reference_contact(problem, pstar, args.cache, key, rows, path, args.reference_rtol)
         for name in floors:
-            run_floor(problem, pstar, contact, key, name, rows, path)
+            run_floor(problem, pstar, contact, key, name, rows, path, args.reference_rtol)
         if gaps:
             run_gaps(problem, contact, key, rows, path)
         for width in widths:

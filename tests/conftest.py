@@ -1,6 +1,7 @@
 """Shared test set-up: PETSc initialised once; helpers to run the command line."""
 
 import faulthandler
+import json
 import os
 import pty
 import subprocess
@@ -96,6 +97,24 @@ def run_cli(args, ranks=1, cwd=None):
     env = dict(os.environ, **MPI_ENV)
     env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
     return run_process(command, cwd=cwd or ROOT, env=env)
+
+
+def assert_parallel_equals_serial(args, tmp_path, printed, counted):
+    """The first step of ``python -m roughpetsc args`` on 1, 2 and 3 ranks: the same iterations, pairs, the
+    ``counted`` pairs (positive), contact area, and mean gap to round-off; ``printed`` is in every table."""
+    steps = {}
+    for ranks in (1, 2, 3):
+        out = tmp_path / f"run{ranks}.json"
+        done = run_cli(list(args) + ["-json", out], ranks=ranks)
+        assert done.returncode == 0, done.stderr
+        steps[ranks] = json.loads(out.read_text())["steps"][0]
+        assert printed in done.stdout
+    for ranks in (2, 3):
+        assert steps[ranks]["iterations"] == steps[1]["iterations"]
+        assert steps[ranks]["operator_applications"] == steps[1]["operator_applications"]
+        assert steps[ranks][counted] == steps[1][counted] > 0
+        assert steps[ranks]["A"] == steps[1]["A"]
+        assert abs(steps[ranks]["gstar"] - steps[1]["gstar"]) <= 1e-12 * abs(steps[1]["gstar"])
 
 
 def run_on_terminal(command, cwd=None):

@@ -453,6 +453,8 @@ def step_line(step):
     plastic = f"  A_plastic {step['A_plastic']:.5g}" if step.get("A_plastic") else ""
     coarse = step.get("cascade_applications")
     cascade = f"  + {coarse:.1f} Kapps of the coarse start (in fine-grid Kapps)" if coarse else ""
+    split = step.get("split_applications")
+    cascade += f"  + {split:.2f} Kapps of the split corrections (in fine-grid Kapps)" if split else ""
     return (f"{step['pstar']:10.5g} {step['A']:10.5g} {step['A_corrected']:10.5g} {step['gstar']:11.5g} "
             f"{step['kkt']['natural']:9.2e} {step['iterations']:6d} {step['operator_applications']:6d} "
             f"{step['time_s']:8.3f}  {step['reason']}{flag}{plastic}{cascade}")

@@ -98,19 +98,26 @@ def step_sums(response, contact, t, gap):
 
 
 @njit(cache=True, fastmath={"reassoc"})
-def take_step(p, t, displacement, response, step, upper):
-    """``p -= step t`` onto [0, upper], ``K p -= step K t``; local ``(nodes the projection moved, sum of p)``."""
+def take_step(p, t, displacement, response, step, upper, corrections):
+    """``p -= step t`` onto [0, upper], ``K p -= step K t``; local ``(nodes the projection moved, sum of p)``.
+
+    ``corrections`` (empty, or as long as p) receives what the projection added to each node (0 elsewhere).
+    """
     clipped = 0
     total = 0.0
+    record = corrections.size > 0
     for i in range(p.size):
         displacement[i] -= step * response[i]
-        value = p[i] - step * t[i]
+        trial = p[i] - step * t[i]
+        value = trial
         if value < 0.0:
             value = 0.0
             clipped += 1
         elif value > upper:
             value = upper
             clipped += 1
+        if record:
+            corrections[i] = value - trial
         p[i] = value
         total += value
     return clipped, total

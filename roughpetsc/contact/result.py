@@ -23,7 +23,9 @@ class Result:
     (3.50) over the elastic contact nodes; ``A_plastic`` the fraction of nodes at the cap; ``energy`` the total
     energy per unit area of an adhesive solution (pressure x length units, :mod:`~roughpetsc.contact.adhesive`);
     ``cascade_applications`` the FFT pairs of a cold start's coarse solves (:mod:`roughpetsc.solvers.cascade`)
-    in fine-grid pairs (each level's weighted by its size), beside ``operator_applications`` on the grid itself.
+    in fine-grid pairs (each level's weighted by its size), beside ``operator_applications`` on the grid itself;
+    ``split_applications`` the coarse FFT pairs of Polonsky-Keer's split corrections (:mod:`roughpetsc.elastic.split`),
+    in fine-grid pairs as well.
     """
 
     pbar: float
@@ -46,6 +48,7 @@ class Result:
     A_plastic: float = 0.0
     energy: float = None
     cascade_applications: float = 0.0
+    split_applications: float = 0.0
 
     def summary(self):
         """A JSON-ready dict (no fields, no history)."""

@@ -11,5 +11,6 @@ __getattr__, __dir__, __all__ = exports(__name__, {
     "operator": "FilterOperator",
     "westergaard": "Westergaard",
     "love": "FreeBoundary",
+    "split": "SplitCompliance",
     "stresses": "periodic_stresses free_stresses",
 })

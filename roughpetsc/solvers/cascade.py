@@ -28,6 +28,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..errors import UserError
+from ..elastic.split import applicable as split_applicable
 from ..parallel import allgather_rows
 from .stopping import option_name, read_option
 
@@ -112,7 +113,19 @@ def make_cascade(problem, control, prefix=None):
     if why_not:
         raise UserError(f"{option_name('cascade_coarsest', prefix)}: {why_not}")
     factors = coarsening_factors(problem.grid.shape, coarsest)
-    return CascadeStart(problem, factors, rtol) if factors else None
+    return CascadeStart(problem, factors, rtol, split_settings(prefix)) if factors else None
+
+
+def split_settings(prefix):
+    """The split corrections the fine solve was asked for (``-pk_split_*``), for the coarse levels too; or None."""
+    from .polonsky_keer import SPLIT_COARSENING, SPLIT_REFRESH
+
+    options = PETSc.Options(prefix)
+    radius = read_option(options, "Int", "pk_split_radius", 0)
+    if radius <= 0:
+        return None
+    return (radius, read_option(options, "Int", "pk_split_coarsening", SPLIT_COARSENING),
+            read_option(options, "Real", "pk_split_refresh", SPLIT_REFRESH))
 
 
 class CascadeStart:
@@ -126,10 +139,11 @@ class CascadeStart:
         FFT pairs of the coarse solves so far, in fine-grid pairs (each level's weighted by its size).
     """
 
-    def __init__(self, problem, factors, rtol):
+    def __init__(self, problem, factors, rtol, split=None):
         self.problem = problem
         self.factors = tuple(factors)
         self.rtol = rtol
+        self.split = split  # (radius, coarsening, refresh) of the fine solve's split corrections, or None
         self.pairs = 0.0
 
     def take_pairs(self):
@@ -164,15 +178,18 @@ class CascadeStart:
         """Solve one coarse level from the prolongated ``below`` (None: uniform); its signed field, gathered."""
         from .facade import Solver
 
-        solver = Solver(coarse, "load", "pk", self.rtol, options={"cascade_coarsest": 0})
+        options = {"cascade_coarsest": 0, "pk_split_radius": 0}
+        if self.split is not None and split_applicable(coarse.operator, *self.split[:2]) is None:
+            options.update(zip(("pk_split_radius", "pk_split_coarsening", "pk_split_refresh"), self.split))
+        solver = Solver(coarse, "load", "pk", self.rtol, options=options)
         try:
             if below is not None:
                 def start(target, pressure):
                     coarse.local(pressure)[...] = np.maximum(prolong_bilinear_rows(below, coarse.local_rows), 0.0)
                 solver.path.cold_start = start
             applications = coarse.operator.applications
-            solver.solve(pbar=pbar)
-            self.pairs += (coarse.operator.applications - applications) / factor ** 2
+            result = solver.solve(pbar=pbar)
+            self.pairs += (coarse.operator.applications - applications + result.split_applications) / factor ** 2
             p = coarse.local(solver.pressure, readonly=True)
             gap = coarse.local(solver.work, readonly=True)
             signed = p - coarse.operator.stiffness_diagonal * np.maximum(gap, 0.0)

@@ -85,6 +85,10 @@ class Solver:
         """The backend's TAO object: for monitors and views."""
         return self.backend.tao
 
+    def split_applications(self):
+        """The backend's coarse FFT pairs so far (an optional attribute of the protocol: 0 if it has none)."""
+        return getattr(self.backend, "split_applications", 0.0)
+
     def unusable_options(self):
         """Options given that the backend read but cannot use (Polonsky-Keer has no line search or KSP)."""
         return self.backend.unusable_options()
@@ -98,6 +102,7 @@ class Solver:
         problem = self.problem
         started = time.perf_counter()
         applications = problem.operator.applications
+        split_applications = self.split_applications()
         control = "displacement" if gbar is not None else ("load" if (pbar, pstar) != (None, None) else self.control)
         if control != self.control:
             given = "gbar" if gbar is not None else ("pstar" if pstar is not None else "pbar")
@@ -115,6 +120,7 @@ class Solver:
             outcome = Outcome(resumed.separation, outcome.iterations + resumed.iterations, resumed.reason,
                               np.concatenate([outcome.history, resumed.history]))
             result = self._certify(outcome, target, started, applications)
+        result.split_applications = self.split_applications() - split_applications
         if self.cascade is not None:
             result.cascade_applications = self.cascade.take_pairs()
         self.path.record(control, target, outcome, self.work)

@@ -18,6 +18,12 @@ OPTIONS = [
     ("pk_active_set", "bccg", "Polonsky-Keer active set: bccg (overlapping nodes join the free set, Polak-Ribiere "
                               "without restarts) | pk (as published: nodes enter after the step, CG restarts)"),
     ("pk_refresh", 50, "Polonsky-Keer: recompute K p from scratch at least every this many iterations"),
+    ("pk_split_radius", 0, "Polonsky-Keer: after a step the projection moved, add K of its corrections by a stencil "
+                           "of this many nodes (32 measured best) and a coarse far field instead of a fresh K p "
+                           "(0, the default: a fresh K p; periodic grids with square cells, bccg, no hardness cap)"),
+    ("pk_split_coarsening", 4, "Polonsky-Keer: the split's far field is computed on a grid this many times coarser"),
+    ("pk_split_refresh", 1e-2, "Polonsky-Keer: with split corrections, K p is computed afresh each time the "
+                               "residual falls by this factor"),
 ]
 
 
@@ -40,6 +46,10 @@ class PKBackend(Backend):
     @property
     def name(self):
         return f"pk({self.context.preconditioner})"
+
+    @property
+    def split_applications(self):
+        return self.context.split_applications
 
     @property
     def separation(self):

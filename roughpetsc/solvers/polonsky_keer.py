@@ -14,9 +14,14 @@ from ..contact.certificate import KKTReport
 from ..parallel import allmax, allsum
 from .preconditioner import FourierPreconditioner
 from ..contact import loops
+from ..elastic import split as split_compliance
 
 PRECONDITIONERS = ("none", "fourier")
 ACTIVE_SETS = ("pk", "bccg")
+SPLIT_RADIUS, SPLIT_COARSENING, SPLIT_REFRESH = 0, 4, 1e-2  # off: fewer pairs, no faster (docs/solvers.md)
+# The stencil's work, (2 R + 1)^2 per corrected node, is spent only up to this many grid sizes (a few per cent of
+# a pair's); beyond (a step from a poor start that clips much of the grid) a fresh K p is cheaper.
+SPLIT_WORK = 32
 
 
 class PolonskyKeer:
@@ -35,6 +40,11 @@ class PolonskyKeer:
         self.preconditioner = "fourier"
         self.refresh = 50
         self.active_set = "bccg"
+        # The projection's corrections by the split compliance (elastic/split.py) instead of a fresh K p.
+        self.split_radius, self.split_coarsening, self.split_refresh = SPLIT_RADIUS, SPLIT_COARSENING, SPLIT_REFRESH
+        self.split_given = False
+        self.split = None
+        self.corrections = None
         self.option_error = None  # what setFromOptions refused, raised by the caller after it returns
         self.history = None
         # K p of the start, if the caller knows it (then the first fresh K p is skipped); cleared by solve.
@@ -60,8 +70,15 @@ class PolonskyKeer:
         self.active_set = options.getString("pk_active_set", self.active_set)
         try:
             self.refresh = read_option(options, "Int", "pk_refresh", self.refresh)
+            self.split_radius = read_option(options, "Int", "pk_split_radius", self.split_radius)
+            self.split_coarsening = read_option(options, "Int", "pk_split_coarsening", self.split_coarsening)
+            self.split_refresh = read_option(options, "Real", "pk_split_refresh", self.split_refresh)
         except UserError as error:
             self.option_error = error
+            return
+        self.split_given = options.hasName("pk_split_radius") and self.split_radius > 0
+        self.option_error = self._split_option_error(prefix)
+        if self.option_error:
             return
         if self.preconditioner not in PRECONDITIONERS:
             self.option_error = UserError(f"{option_name('pk_pc', prefix)}: unknown preconditioner "
@@ -73,11 +90,64 @@ class PolonskyKeer:
             self.option_error = UserError(f"{option_name('pk_refresh', prefix)} must be a positive number of "
                                           f"iterations, got {self.refresh}")
 
+    def _split_option_error(self, prefix):
+        """The split's options refused, or None; where the split cannot apply it is off, or refused if asked for."""
+        if self.split_radius < 0 or self.split_coarsening < 1:
+            return UserError(f"{option_name('pk_split_radius', prefix)} must be 0 (off) or a radius of at least 2 "
+                             f"nodes and {option_name('pk_split_coarsening', prefix)} at least 1, got "
+                             f"{self.split_radius} and {self.split_coarsening}")
+        if not 0.0 < self.split_refresh < 1.0:
+            return UserError(f"{option_name('pk_split_refresh', prefix)} must lie in (0, 1), got {self.split_refresh:g}")
+        reason = self.split_unusable()
+        if reason and self.split_given:
+            return UserError(f"{option_name('pk_split_radius', prefix)} {self.split_radius}: the split correction "
+                             f"cannot apply here: {reason} (give 0 to turn it off)")
+        return None
+
+    def split_unusable(self):
+        """Why the projection's corrections cannot go through the split compliance here, or None."""
+        if self.split_radius == 0:
+            return "it is turned off"
+        if self.active_set != "bccg":
+            return "the pk active set enters nodes off the step (a fresh K p follows)"
+        if self.problem.upper_bound is not None:
+            return "a hardness cap rescales the load with a fresh K p"
+        return split_compliance.applicable(self.problem.operator, self.split_radius, self.split_coarsening)
+
+    @property
+    def split_applications(self):
+        """The split's coarse FFT pairs so far, in pairs of the grid."""
+        return self.split.coarse_applications if self.split is not None else 0.0
+
+    def _split_ready(self):
+        """The split compliance (built on first use: one pair), or None where it does not apply."""
+        if self.split is None and self.split_unusable() is None:
+            problem = self.problem
+            self.split = split_compliance.SplitCompliance(problem.operator, self.split_radius, self.split_coarsening,
+                                                          self.vecs[2], self.vecs[4], problem.mpi)
+            self.corrections = np.zeros(problem.local(problem.heights, readonly=True).size)
+        return self.split
+
+    def _add_corrections(self, displacement):
+        """``K p += K c`` for the projection's corrections c (:attr:`corrections`) by the split compliance."""
+        problem = self.problem
+        nodes = np.flatnonzero(self.corrections)
+        n1 = problem.grid.n1
+        rows = nodes // n1 + problem.operator.local_rows.start
+        parts = (rows, nodes % n1, self.corrections[nodes])
+        if problem.mpi.Get_size() > 1:
+            parts = [np.concatenate(part) for part in zip(*problem.mpi.allgather(parts))]
+        self.split.add(*parts, displacement.reshape(problem.operator.local_shape))
+
     def view(self, tao, viewer):
         """-tao_view: PK's own settings; the line search and KSP that PETSc then lists are never used."""
         limit = f"{self.rule.max_seconds:g} s" if self.rule.max_seconds > 0 else "none"
+        unusable = self.split_unusable()
+        split = (f"projection corrections by the split compliance (radius {self.split_radius}, coarsening "
+                 f"{self.split_coarsening}, K p afresh at each {self.split_refresh:g} x fall of the residual)"
+                 if unusable is None else f"a fresh K p after each projection ({unusable.split(' (')[0]})")
         for line in (f"Polonsky-Keer CG, active set {self.active_set}, preconditioner {self.preconditioner}, K p "
-                     f"refreshed every {self.refresh} iterations",
+                     f"refreshed every {self.refresh} iterations", split,
                      f"stops at a natural KKT residual (and load error) of {self.rule.rtol:g}; time limit {limit}",
                      "(PETSc lists below the line search and KSP that every TAO holds: Polonsky-Keer uses neither, "
                      "and their options are reported as unused)"):
@@ -127,6 +197,10 @@ class PolonskyKeer:
         tao.setIterationNumber(0)
         rz_old, conjugate, fresh_needed = 1.0, False, True
         since_fresh = 0
+        split = self._split_ready()
+        corrections = self.corrections if split is not None else np.empty(0)
+        # K p carries split corrections since it was last computed afresh, when the residual was fresh_natural.
+        approximated, fresh_natural = False, np.inf
         if self.initial_displacement is not None:
             self.initial_displacement.copy(displacement_vec)
             # Not fresh: with confirm, convergence at once is still confirmed on a computed K p.
@@ -136,13 +210,20 @@ class PolonskyKeer:
         while True:
             if fresh_needed or since_fresh >= self.refresh:
                 operator.displacement(pressure, displacement_vec)
-                since_fresh, fresh_needed = 0, False
+                since_fresh, fresh_needed, approximated = 0, False, False
             fresh = since_fresh == 0
             # Plastic nodes (their gap may be negative) are not in the contact set that fixes d.
             count, gap_sum, total = allsum(mpi, loops.contact_and_gap(p, displacement, h, gap, contact, upper))
             if load_control and count:  # d makes the mean gap on the contact set zero (a fully plastic
                 self.separation = -gap_sum / count  # contact keeps the last d)
             kkt = self._report(p, gap, total, pbar, upper)
+            if fresh:
+                fresh_natural = kkt.natural
+            elif approximated and kkt.natural < self.split_refresh * fresh_natural:
+                # The corrections' errors are fixed in size while the residual falls: clear them before they
+                # steer the directions.
+                fresh_needed = True
+                continue
             self.current = (kkt.natural, kkt.load_error, fresh)
             reason = check_convergence(tao)
             if test.verdict is Verdict.CONFIRM:
@@ -189,7 +270,7 @@ class PolonskyKeer:
                 break
             step = numerator / denominator
             # p - step t projected onto [0, upper]; K p - step K t, the displacement of the unprojected step.
-            clipped, total = loops.take_step(p, t, displacement, response, step, upper)
+            clipped, total = loops.take_step(p, t, displacement, response, step, upper, corrections)
             if bccg:
                 changed, total = allsum(mpi, [clipped, total])
                 entering = 0
@@ -202,7 +283,11 @@ class PolonskyKeer:
                     np.copyto(p, -step * gap, where=overlap)
                 total, = allsum(mpi, [p.sum()])
                 conjugate = entering == 0
-            fresh_needed = bool(changed or entering)
+            if changed and split is not None and changed * (2 * self.split_radius + 1) ** 2 <= SPLIT_WORK * n:
+                self._add_corrections(displacement)
+                approximated = True
+            else:
+                fresh_needed = bool(changed or entering)
             if load_control and cap is None:
                 loops.rescale(p, displacement, pbar * n / total)
             elif load_control:

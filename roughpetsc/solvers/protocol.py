@@ -68,6 +68,7 @@ class Backend:
     """The defaults of the optional parts of the backend protocol; backends may derive from it."""
 
     keeps_displacement = False
+    split_applications = 0.0  # coarse FFT pairs so far beside the problem operator's, in its pairs (cumulative)
 
     def solve(self, target, unknown, guess):
         raise NotImplementedError

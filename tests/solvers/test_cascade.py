@@ -4,7 +4,6 @@ References: scipy's linear interpolation for the prolongation; the solve from th
 answer from another start) and the KKT certificate for the solution; the serial run for the parallel one.
 """
 
-import json
 
 import numpy as np
 import pytest
@@ -15,7 +14,7 @@ from roughpetsc import ContactProblem, Grid, Solver, fractal
 from roughpetsc.errors import UserError
 from roughpetsc.solvers.cascade import coarsening_factors, make_cascade, prolong_bilinear_rows
 
-from conftest import run_cli
+from conftest import assert_parallel_equals_serial
 
 EFFORT = "FFTW_ESTIMATE"
 
@@ -123,19 +122,8 @@ def test_refusals_name_the_option(options, control, hardness, words):
 def test_parallel_cascade_equals_serial(tmp_path):
     args = ["-surface_N", 128, "-surface_kl", 8, "-surface_ks", 32, "-pstar", 0.5, "-cascade_coarsest", 32,
             "-fft_effort", "FFTW_ESTIMATE"]
-    steps = {}
-    for ranks in (1, 2, 3):
-        out = tmp_path / f"run{ranks}.json"
-        done = run_cli(args + ["-json", out], ranks=ranks)
-        assert done.returncode == 0, done.stderr
-        steps[ranks] = json.loads(out.read_text())["steps"][0]
-        assert "coarse start" in done.stdout
-    for ranks in (2, 3):
-        assert steps[ranks]["iterations"] == steps[1]["iterations"]
-        assert steps[ranks]["operator_applications"] == steps[1]["operator_applications"]
-        assert steps[ranks]["cascade_applications"] == steps[1]["cascade_applications"] > 0
-        assert steps[ranks]["A"] == steps[1]["A"]
-        assert abs(steps[ranks]["gstar"] - steps[1]["gstar"]) <= 1e-12 * abs(steps[1]["gstar"])
+    assert_parallel_equals_serial(args, tmp_path, "coarse start", "cascade_applications")
+
 
 
 def test_a_start_put_in_the_pressure_is_solved_from_its_own_displacement():
