@@ -427,8 +427,11 @@ def status(cases):
     third_grid_surfaces = "; ".join(f"{len(s)} surface{'s' if len(s) != 1 else ''} ({seed_list(sorted(s))}) at "
                                     f"1/{r:g}" for (protocol, n, r), s in sorted(have.items())
                                     if protocol == "partial" and n > PLANNED_FINEST)
-    lines = ["## Status: a partial campaign", "",
-             f"**The campaign is partial: {done} of the {planned} planned cycles have case files.** The plan is "
+    status = (f"**All {planned} planned cycles have case files; the third grid (2048^2, outside the plan) is "
+              f"under way.**" if done == planned else
+              f"**The campaign is partial: {done} of the {planned} planned cycles have case files.**")
+    lines = [f"## Status: {'the plan done, a third grid under way' if done == planned else 'a partial campaign'}", "",
+             f"{status} The plan is "
              "`studies/adhesion_rough_runs.sh` (group #1, p*max = 2: 512^2 and 1024^2, ten surfaces, sigma0/E* = "
              "1/100, 1/50, 1/20, partial protocol; full cycles at 512^2, 1/100 and 1/50). What exists:", ""]
     for (protocol, n, ratio), seeds in sorted(have.items(), key=lambda kv: (kv[0][0] != "partial", kv[0][1],
