@@ -98,14 +98,15 @@ def step_sums(response, contact, t, gap):
 
 
 @njit(cache=True, fastmath={"reassoc"})
-def take_step(p, t, displacement, response, step, upper, corrections):
+def take_step(p, t, displacement, response, step, upper, moved_nodes, moved_by):
     """``p -= step t`` onto [0, upper], ``K p -= step K t``; local ``(nodes the projection moved, sum of p)``.
 
-    ``corrections`` (empty, or as long as p) receives what the projection added to each node (0 elsewhere).
+    The first ``moved_nodes.size`` nodes the projection moved are listed in ``moved_nodes`` (local flat
+    indices), with what it added to each in ``moved_by`` (empty arrays: none listed).
     """
     clipped = 0
     total = 0.0
-    record = corrections.size > 0
+    room = moved_nodes.size
     for i in range(p.size):
         displacement[i] -= step * response[i]
         trial = p[i] - step * t[i]
@@ -116,8 +117,9 @@ def take_step(p, t, displacement, response, step, upper, corrections):
         elif value > upper:
             value = upper
             clipped += 1
-        if record:
-            corrections[i] = value - trial
+        if value != trial and clipped <= room:  # moved: clipped counts it already
+            moved_nodes[clipped - 1] = i
+            moved_by[clipped - 1] = value - trial
         p[i] = value
         total += value
     return clipped, total

@@ -86,6 +86,7 @@ class SplitCompliance:
         self.n0, self.n1 = operator.grid.n0, operator.grid.n1
         self.row0 = operator.local_rows.start
         self.coarse_applications = 0.0
+        self._coarse = np.zeros((self.n0 // coarsening, self.n1 // coarsening))
         kernel = self._kernel(operator, pressure, work)
         self.near, self.far_symbol = self._split(kernel)
 
@@ -125,7 +126,8 @@ class SplitCompliance:
             return
         add_near(out, self.row0, rows, cols, values, self.near, self.radius, self.n0, self.n1)
         s = self.coarsening
-        coarse = np.zeros((self.n0 // s, self.n1 // s))
+        coarse = self._coarse
+        coarse.fill(0.0)
         restrict_points(coarse, rows, cols, values, s)
         response = np.fft.irfft2(np.fft.rfft2(coarse) * self.far_symbol, s=coarse.shape)
         self.coarse_applications += 1.0 / (s * s)

@@ -44,7 +44,7 @@ class PolonskyKeer:
         self.split_radius, self.split_coarsening, self.split_refresh = SPLIT_RADIUS, SPLIT_COARSENING, SPLIT_REFRESH
         self.split_given = False
         self.split = None
-        self.corrections = None
+        self.moved = (np.empty(0, dtype=np.int64), np.empty(0))  # the nodes a step's projection moved, and by how much
         self.option_error = None  # what setFromOptions refused, raised by the caller after it returns
         self.history = None
         # K p of the start, if the caller knows it (then the first fresh K p is skipped); cleared by solve.
@@ -125,16 +125,20 @@ class PolonskyKeer:
             problem = self.problem
             self.split = split_compliance.SplitCompliance(problem.operator, self.split_radius, self.split_coarsening,
                                                           self.vecs[2], self.vecs[4], problem.mpi)
-            self.corrections = np.zeros(problem.local(problem.heights, readonly=True).size)
+            # Room for as many moved nodes as the stencil's work allows: a step that moves more takes a fresh K p.
+            room = min(problem.local(problem.heights, readonly=True).size,
+                       SPLIT_WORK * problem.n // (2 * self.split_radius + 1) ** 2)
+            self.moved = (np.empty(room, dtype=np.int64), np.empty(room))
         return self.split
 
-    def _add_corrections(self, displacement):
-        """``K p += K c`` for the projection's corrections c (:attr:`corrections`) by the split compliance."""
+    def _add_corrections(self, displacement, moved):
+        """``K p += K c`` for the projection's corrections c at the ``moved`` nodes of this rank (listed in
+        :attr:`moved`) by the split compliance."""
         problem = self.problem
-        nodes = np.flatnonzero(self.corrections)
+        nodes, values = (array[:moved] for array in self.moved)
         n1 = problem.grid.n1
         rows = nodes // n1 + problem.operator.local_rows.start
-        parts = (rows, nodes % n1, self.corrections[nodes])
+        parts = (rows, nodes % n1, values.copy())
         if problem.mpi.Get_size() > 1:
             parts = [np.concatenate(part) for part in zip(*problem.mpi.allgather(parts))]
         self.split.add(*parts, displacement.reshape(problem.operator.local_shape))
@@ -198,7 +202,7 @@ class PolonskyKeer:
         rz_old, conjugate, fresh_needed = 1.0, False, True
         since_fresh = 0
         split = self._split_ready()
-        corrections = self.corrections if split is not None else np.empty(0)
+        moved_nodes, moved_by = self.moved
         # K p carries split corrections since it was last computed afresh, when the residual was fresh_natural.
         approximated, fresh_natural = False, np.inf
         if self.initial_displacement is not None:
@@ -270,7 +274,8 @@ class PolonskyKeer:
                 break
             step = numerator / denominator
             # p - step t projected onto [0, upper]; K p - step K t, the displacement of the unprojected step.
-            clipped, total = loops.take_step(p, t, displacement, response, step, upper, corrections)
+            clipped, total = loops.take_step(p, t, displacement, response, step, upper, moved_nodes, moved_by)
+            moved = clipped
             if bccg:
                 changed, total = allsum(mpi, [clipped, total])
                 entering = 0
@@ -284,7 +289,7 @@ class PolonskyKeer:
                 total, = allsum(mpi, [p.sum()])
                 conjugate = entering == 0
             if changed and split is not None and changed * (2 * self.split_radius + 1) ** 2 <= SPLIT_WORK * n:
-                self._add_corrections(displacement)
+                self._add_corrections(displacement, moved)
                 approximated = True
             else:
                 fresh_needed = bool(changed or entering)
