@@ -1105,8 +1105,10 @@ def report(rows):
                   "04:37 took 2.82 / 2.79 / 3.00 s against 2.40 / 1.95 / 2.25 s at 02:55 (pk / pk-cascade / "
                   "pk-split), so a wall-time ratio within 20 % of 1 says nothing here. Pairs: `pk-split` stays "
                   "within 1.3x the floor at N = 2048-4096, but at 8192, p* = 0.5 it takes 58 fine iterations "
-                  "against the cascade start's 46 (1.59x the floor); why is not measured yet (the far field's error between the 100-fold "
-                  "refreshes is the first suspect).", ""]
+                  "against the cascade start's 46 (1.59x the floor). With K p afresh at each 10-fold fall instead (`python -m roughpetsc "
+                  "-options_file options/group01.opts -surface_N 8192 -pstar 0.5 -pk_split_radius 32 "
+                  "-pk_split_refresh 1e-1`) it takes 62 (138 + 8.8 + 3.31 = 150.1 pairs), so the far field's "
+                  "error between refreshes is not what costs those iterations; why is open.", ""]
     peers = peer_table()
     if peers:
         lines += [f"Against Tamaas ({peers[0]['started']}, `studies/output/peers.md`; group 1 with the peers' "
