@@ -928,11 +928,13 @@ def idle_timing_table(rows, keys):
                 cells.append(f"{r['seconds'] / pk['seconds']:.2f}")
         certified = sum(found[name]["converged"] for name, _ in TIMED_SOLVERS)
         table.append([group, f"{pstar:g}", n, fmt(floor)] + cells
-                     + [f"{1e3 * pk['seconds'] / pk['pairs']:.3g}", f"{pk['load_before']:.2f} / {pk['load_after']:.2f}",
-                        f"{certified}/{len(TIMED_SOLVERS)}"])
+                     + [f"{1e3 * pk['seconds'] / pk['pairs']:.3g}",
+                        f"{pk['load_before']:.2f} / {pk['load_after']:.2f}", f"{certified}/{len(TIMED_SOLVERS)}"])
     header = ["group", "p*", "N", "floor pairs"]
     for name, _ in TIMED_SOLVERS:
-        header += [f"{name} iterations", f"{name} pairs (/ floor)", f"{name} s"] + ([f"{name} s / pk s"] if name != "pk" else [])
+        header += [f"{name} iterations", f"{name} pairs (/ floor)", f"{name} s"]
+        if name != "pk":
+            header.append(f"{name} s / pk s")
     return common.markdown_table(header + ["pk ms per pair", "load average before / after", "converged"], table)
 
 
@@ -1105,10 +1107,11 @@ def report(rows):
                   "04:37 took 2.82 / 2.79 / 3.00 s against 2.40 / 1.95 / 2.25 s at 02:55 (pk / pk-cascade / "
                   "pk-split), so a wall-time ratio within 20 % of 1 says nothing here. Pairs: `pk-split` stays "
                   "within 1.3x the floor at N = 2048-4096, but at 8192, p* = 0.5 it takes 58 fine iterations "
-                  "against the cascade start's 46 (1.59x the floor). With K p afresh at each 10-fold fall instead (`python -m roughpetsc "
-                  "-options_file options/group01.opts -surface_N 8192 -pstar 0.5 -pk_split_radius 32 "
-                  "-pk_split_refresh 1e-1`) it takes 62 (138 + 8.8 + 3.31 = 150.1 pairs), so the far field's "
-                  "error between refreshes is not what costs those iterations; why is open.", ""]
+                  "against the cascade start's 46 (1.59x the floor). With K p afresh at each 10-fold fall "
+                  "instead (`python -m roughpetsc -options_file options/group01.opts -surface_N 8192 -pstar 0.5 "
+                  "-pk_split_radius 32 -pk_split_refresh 1e-1`) it takes 62 (138 + 8.8 + 3.31 = 150.1 pairs), "
+                  "so the far field's error between refreshes is not what costs those iterations; why is open.",
+                  ""]
     peers = peer_table()
     if peers:
         lines += [f"Against Tamaas ({peers[0]['started']}, `studies/output/peers.md`; group 1 with the peers' "
@@ -1167,8 +1170,8 @@ def main():
     parser.add_argument("--loads", type=float, nargs="*", default=[0.05, 0.5, 2.0])
     parser.add_argument("--groups", type=int, nargs="*", default=[1, 18])
     parser.add_argument("--parts", nargs="*", default=["reference", "pk", "floor", "cold"],
-                        choices=["reference", "pk", "floor", "cold", "pkcascade", "pksplit", "projections", "slepc", "warm",
-                                 "warmfloor", "exactband", "gaps", "timing"])
+                        choices=["reference", "pk", "floor", "cold", "pkcascade", "pksplit", "projections", "slepc",
+                                 "warm", "warmfloor", "exactband", "gaps", "timing"])
     parser.add_argument("--widths", type=int, nargs="*", default=[1, 2, 4, 8],
                         help="band widths of the exactband diagnostic")
     parser.add_argument("--floor-pcs", nargs="*", default=["fourier", "band2"], choices=list(PRECONDITIONERS))
