@@ -138,7 +138,7 @@ class PolonskyKeer:
         nodes, values = (array[:moved] for array in self.moved)
         n1 = problem.grid.n1
         rows = nodes // n1 + problem.operator.local_rows.start
-        parts = (rows, nodes % n1, values.copy())
+        parts = (rows, nodes % n1, values)
         if problem.mpi.Get_size() > 1:
             parts = [np.concatenate(part) for part in zip(*problem.mpi.allgather(parts))]
         self.split.add(*parts, displacement.reshape(problem.operator.local_shape))
@@ -275,7 +275,6 @@ class PolonskyKeer:
             step = numerator / denominator
             # p - step t projected onto [0, upper]; K p - step K t, the displacement of the unprojected step.
             clipped, total = loops.take_step(p, t, displacement, response, step, upper, moved_nodes, moved_by)
-            moved = clipped
             if bccg:
                 changed, total = allsum(mpi, [clipped, total])
                 entering = 0
@@ -289,7 +288,7 @@ class PolonskyKeer:
                 total, = allsum(mpi, [p.sum()])
                 conjugate = entering == 0
             if changed and split is not None and changed * (2 * self.split_radius + 1) ** 2 <= SPLIT_WORK * n:
-                self._add_corrections(displacement, moved)
+                self._add_corrections(displacement, clipped)
                 approximated = True
             else:
                 fresh_needed = bool(changed or entering)
