@@ -1105,16 +1105,35 @@ def report(rows):
                   idle_timing_table(rows, keys), "", idle_reading(rows, keys), "",
                   "The host's speed drifted within the run: group 1, N = 1024, p* = 0.5 timed again the same way at "
                   "04:37 took 2.82 / 2.79 / 3.00 s against 2.40 / 1.95 / 2.25 s at 02:55 (pk / pk-cascade / "
-                  "pk-split), so a wall-time ratio within 20 % of 1 says nothing here. Pairs: `pk-split` stays "
-                  "within 1.3x the floor at N = 2048-4096, but at 8192, p* = 0.5 it takes 58 fine iterations "
-                  "against the cascade start's 46 (1.59x the floor). With K p afresh at each 10-fold fall "
+                  "pk-split), so a wall-time ratio within 20 % of 1 says nothing here. Group 18 at N = 8192 ran "
+                  "later (06:14-07:19 UTC, with our other processes stopped). Pairs: `pk-split` stays within 1.3x "
+                  "the floor at N = 2048-4096, but at 8192, p* = 0.5 it takes 58 fine iterations against the "
+                  "cascade start's 46 (group 1, 1.59x the floor) and 65 against 50 (group 18, 1.62x). For group "
+                  "1, with K p afresh at each 10-fold fall "
                   "instead (`python -m roughpetsc -options_file options/group01.opts -surface_N 8192 -pstar 0.5 "
                   "-pk_split_radius 32 -pk_split_refresh 1e-1`) it takes 62 (138 + 8.8 + 3.31 = 150.1 pairs), "
                   "so the far field's error between refreshes is not what costs those iterations. The radius "
                   "matters, and not monotonically: at N = 4096 (group 1, p* = 0.5, `-pk_split_radius R`) R = 16 / 24 "
                   "/ 32 / 48 take 52 / 43 / 43 / 44 iterations and 121.5 / 103.1 / 106.3 / 112.1 pairs (1.48 / 1.26 "
                   "/ 1.30 / 1.37x the floor); at 8192, p* = 0.5, R = 64 takes 51 iterations and 115 + 10.5 + 2.56 = "
-                  "128.1 pairs (1.46x), against R = 32's 58 and 140.2.",
+                  "128.1 pairs (1.46x), against R = 32's 58 and 140.2.", "",
+                  "The far field's accuracy is the lever at N = 8192 only. Its bilinear transfers (the loads "
+                  "restricted by the transpose of the interpolation) leave an error falling like (4 / R)^2: for "
+                  "300 random point loads at N = 1024 an rms of 1.45e-4 / 3.7e-5 of max |K c| at R = 32 / 64. "
+                  "Cubic transfers (4-point Lagrange, restriction its transpose) cut it 3-5 times, to 4.2e-5 / "
+                  "7.1e-6, for 6 ms more per corrected step at N = 2048 (23 against 17 ms; a pair takes 58 ms). "
+                  "With them (group 1, p* = 0.5) N = 8192, R = 32 takes 51 iterations and 113 + 8.5 + 2.69 = "
+                  "124.2 pairs (1.41x the floor; timed beside other work, so no time), as many as bilinear R = 64 "
+                  "and against bilinear R = 32's 58. Below 8192 they gain nothing: at N = 4096 R = 16 / 24 / 32 "
+                  "took 50 / 44 / 46 iterations (1.43 / 1.28 / 1.38x) against bilinear's 52 / 43 / 43, at 2048 "
+                  "R = 8 / 16 / 32 took 47 / 39 / 38 against 44 / 40 / 38. Where the far field is far off the "
+                  "iterations grow at any N: at 2048, R = 8 takes 44, but 38 (the cascade start's count without "
+                  "the split) with the far field exact (`-pk_split_coarsening 1`), and R = 16 takes 38 with "
+                  "coarsening 2. Above that, below 8192, a change of the path moves the count by a few iterations "
+                  "either way. A reading consistent with this: a step's far-field errors add up over its "
+                  "corrected nodes, whose number grows with N, so the accuracy a step needs grows with N. The "
+                  "cubic transfers were not kept (a loss at 4096, and the time): an accuracy chosen from N is the "
+                  "next candidate.",
                   ""]
     peers = peer_table()
     if peers:
