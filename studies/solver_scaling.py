@@ -1120,11 +1120,14 @@ def report(rows):
                   "The far field's accuracy is the lever at N = 8192 only. Its bilinear transfers (the loads "
                   "restricted by the transpose of the interpolation) leave an error falling like (4 / R)^2: for "
                   "300 random point loads at N = 1024 an rms of 1.45e-4 / 3.7e-5 of max |K c| at R = 32 / 64. "
-                  "Cubic transfers (4-point Lagrange, restriction its transpose) cut it 3-5 times, to 4.2e-5 / "
-                  "7.1e-6, for 6 ms more per corrected step at N = 2048 (23 against 17 ms; a pair takes 58 ms). "
+                  "Cubic transfers (`-pk_split_transfer cubic`: 4-point Lagrange, restriction its transpose) cut "
+                  "it 3-5 times, to 4.2e-5 / 7.1e-6, for 6 ms more per corrected step at N = 2048 (23 against 17 "
+                  "ms; a pair takes 58 ms). "
                   "With them (group 1, p* = 0.5) N = 8192, R = 32 takes 51 iterations and 113 + 8.5 + 2.69 = "
                   "124.2 pairs (1.41x the floor; timed beside other work, so no time), as many as bilinear R = 64 "
-                  "and against bilinear R = 32's 58. Below 8192 they gain nothing: at N = 4096 R = 16 / 24 / 32 "
+                  "and against bilinear R = 32's 58; cubic R = 64 takes 52 (118 + 10.5 + 2.5 = 131.0 pairs), so "
+                  "the rest of the gap to the cascade start's 46 does not close with accuracy. Below 8192 they "
+                  "gain nothing: at N = 4096 R = 16 / 24 / 32 "
                   "took 50 / 44 / 46 iterations (1.43 / 1.28 / 1.38x) against bilinear's 52 / 43 / 43, at 2048 "
                   "R = 8 / 16 / 32 took 47 / 39 / 38 against 44 / 40 / 38. Where the far field is far off the "
                   "iterations grow at any N: at 2048, R = 8 takes 44, but 38 (the cascade start's count without "
@@ -1132,8 +1135,8 @@ def report(rows):
                   "coarsening 2. Above that, below 8192, a change of the path moves the count by a few iterations "
                   "either way. A reading consistent with this: a step's far-field errors add up over its "
                   "corrected nodes, whose number grows with N, so the accuracy a step needs grows with N. The "
-                  "cubic transfers were not kept (a loss at 4096, and the time): an accuracy chosen from N is the "
-                  "next candidate.",
+                  "cubic transfers are an option, not the default (a loss at 4096, and the time); what costs the "
+                  "other 5 iterations at 8192 is open.",
                   ""]
     peers = peer_table()
     if peers:

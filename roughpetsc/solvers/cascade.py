@@ -118,14 +118,15 @@ def make_cascade(problem, control, prefix=None):
 
 def split_settings(prefix):
     """The split corrections the fine solve was asked for (``-pk_split_*``), for the coarse levels too; or None."""
-    from .polonsky_keer import SPLIT_COARSENING, SPLIT_REFRESH
+    from .polonsky_keer import SPLIT_COARSENING, SPLIT_REFRESH, SPLIT_TRANSFER
 
     options = PETSc.Options(prefix)
     radius = read_option(options, "Int", "pk_split_radius", 0)
     if radius <= 0:
         return None
     return (radius, read_option(options, "Int", "pk_split_coarsening", SPLIT_COARSENING),
-            read_option(options, "Real", "pk_split_refresh", SPLIT_REFRESH))
+            read_option(options, "Real", "pk_split_refresh", SPLIT_REFRESH),
+            options.getString("pk_split_transfer", SPLIT_TRANSFER))
 
 
 class CascadeStart:
@@ -143,7 +144,7 @@ class CascadeStart:
         self.problem = problem
         self.factors = tuple(factors)
         self.rtol = rtol
-        self.split = split  # (radius, coarsening, refresh) of the fine solve's split corrections, or None
+        self.split = split  # (radius, coarsening, refresh, transfer) of the fine solve's split corrections, or None
         self.pairs = 0.0
 
     def take_pairs(self):
@@ -180,7 +181,8 @@ class CascadeStart:
 
         options = {"cascade_coarsest": 0, "pk_split_radius": 0}
         if self.split is not None and split_applicable(coarse.operator, *self.split[:2]) is None:
-            options.update(zip(("pk_split_radius", "pk_split_coarsening", "pk_split_refresh"), self.split))
+            options.update(zip(("pk_split_radius", "pk_split_coarsening", "pk_split_refresh", "pk_split_transfer"),
+                               self.split))
         solver = Solver(coarse, "load", "pk", self.rtol, options=options)
         try:
             if below is not None:

@@ -19,6 +19,7 @@ from ..elastic import split as split_compliance
 PRECONDITIONERS = ("none", "fourier")
 ACTIVE_SETS = ("pk", "bccg")
 SPLIT_RADIUS, SPLIT_COARSENING, SPLIT_REFRESH = 0, 4, 1e-2  # off: fewer pairs, no faster (docs/solvers.md)
+SPLIT_TRANSFER = "bilinear"  # cubic: fewer iterations at N = 8192 only, and slower (docs/solvers.md)
 # The stencil's work, (2 R + 1)^2 per corrected node, is spent only up to this many grid sizes (a few per cent of
 # a pair's); beyond (a step from a poor start that clips much of the grid) a fresh K p is cheaper.
 SPLIT_WORK = 32
@@ -42,6 +43,7 @@ class PolonskyKeer:
         self.active_set = "bccg"
         # The projection's corrections by the split compliance (elastic/split.py) instead of a fresh K p.
         self.split_radius, self.split_coarsening, self.split_refresh = SPLIT_RADIUS, SPLIT_COARSENING, SPLIT_REFRESH
+        self.split_transfer = SPLIT_TRANSFER
         self.split_given = False
         self.split = None
         self.moved = (np.empty(0, dtype=np.int64), np.empty(0))  # the nodes a step's projection moved, and by how much
@@ -68,6 +70,7 @@ class PolonskyKeer:
         options = PETSc.Options(prefix)
         self.preconditioner = options.getString("pk_pc", self.preconditioner)
         self.active_set = options.getString("pk_active_set", self.active_set)
+        self.split_transfer = options.getString("pk_split_transfer", self.split_transfer)
         try:
             self.refresh = read_option(options, "Int", "pk_refresh", self.refresh)
             self.split_radius = read_option(options, "Int", "pk_split_radius", self.split_radius)
@@ -98,6 +101,14 @@ class PolonskyKeer:
                              f"{self.split_radius} and {self.split_coarsening}")
         if not 0.0 < self.split_refresh < 1.0:
             return UserError(f"{option_name('pk_split_refresh', prefix)} must lie in (0, 1), got {self.split_refresh:g}")
+        if self.split_transfer not in split_compliance.TRANSFERS:
+            return UserError(f"{option_name('pk_split_transfer', prefix)}: unknown transfer '{self.split_transfer}' "
+                             f"(one of {', '.join(split_compliance.TRANSFERS)})")
+        off = [option_name(name, prefix) for name in ("pk_split_coarsening", "pk_split_refresh", "pk_split_transfer")
+               if PETSc.Options(prefix).hasName(name)] if self.split_radius == 0 else []
+        if off:
+            return UserError(f"{', '.join(off)} given, but the split is off ({option_name('pk_split_radius', prefix)} "
+                             f"0, the default): give a radius, or leave {'it' if len(off) == 1 else 'them'} out")
         reason = self.split_unusable()
         if reason and self.split_given:
             return UserError(f"{option_name('pk_split_radius', prefix)} {self.split_radius}: the split correction "
@@ -123,8 +134,9 @@ class PolonskyKeer:
         """The split compliance (built on first use: one pair), or None where it does not apply."""
         if self.split is None and self.split_unusable() is None:
             problem = self.problem
-            self.split = split_compliance.SplitCompliance(problem.operator, self.split_radius, self.split_coarsening,
-                                                          self.vecs[2], self.vecs[4], problem.mpi)
+            self.split = split_compliance.SplitCompliance(
+                problem.operator, self.split_radius, self.split_coarsening, self.vecs[2], self.vecs[4], problem.mpi,
+                self.split_transfer)
             # Room for as many moved nodes as the stencil's work allows: a step that moves more takes a fresh K p.
             room = min(problem.local(problem.heights, readonly=True).size,
                        SPLIT_WORK * problem.n // (2 * self.split_radius + 1) ** 2)
@@ -148,7 +160,8 @@ class PolonskyKeer:
         limit = f"{self.rule.max_seconds:g} s" if self.rule.max_seconds > 0 else "none"
         unusable = self.split_unusable()
         split = (f"projection corrections by the split compliance (radius {self.split_radius}, coarsening "
-                 f"{self.split_coarsening}, K p afresh at each {self.split_refresh:g} x fall of the residual)"
+                 f"{self.split_coarsening}, {self.split_transfer} transfers, K p afresh at each "
+                 f"{self.split_refresh:g} x fall of the residual)"
                  if unusable is None else f"a fresh K p after each projection ({unusable.split(' (')[0]})")
         for line in (f"Polonsky-Keer CG, active set {self.active_set}, preconditioner {self.preconditioner}, K p "
                      f"refreshed every {self.refresh} iterations", split,
