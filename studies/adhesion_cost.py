@@ -38,6 +38,13 @@ WHY = ["## Why the exponential law costs more", "",
        "residual, at gaps of 0.05-0.09 sqrt(m0^h): below 0.079, where S_ii + phi''(g) < 0, so each is unstable "
        "and creeps into contact over about ten iterations. At N = 512 S_ii = 615 exceeds the law's largest "
        "|phi''| = 455, and no node is locally concave.",
+       "- **Its floor** (floor.md, `studies/adhesion_floor.py`): the same CG with the final contact set fixed, "
+       "from the same start, takes 165 / 258 / 276 pairs at g* = 1.5 / 1 / 0.5 (N = 512), 2.4 / 3.1 / 2.4x "
+       "Polonsky-Keer's whole solve, and 3.8 / 4.7 / 3.4x with the certificate: the least eigenvalue of the "
+       "compliance times the Hessian on the free set is 0.043 / 0.016 / 0.029 there (1.003 without adhesion), its "
+       "condition number 85 / 353 / 235 (4.9 / 8.9 / 14.5), and CG's iterations grow about as its square root "
+       "(81 / 127 / 136 against 20 / 26 / 31; the square root of the ratio 4.2 / 6.3 / 4.0). The search of the contact set costs the rest (164 / 125 / 93 pairs). So 3x needs "
+       "a preconditioner for the law's concavity, not a better search of the set.",
        "- **Its time per pair**, about 3x Polonsky-Keer's: the law's exp and expm1 over every node, a few times "
        "per iteration (at N = 512, 2.0 of 4.3 s; one compiled pass for the line search's sum cut a call from 6.0 "
        "to 4.9 ms).",
