@@ -88,13 +88,15 @@ class FixedSet:
         self.scale = math.sqrt(problem.m0p_scaled)
         self.gap_vec, self.elastic_vec = problem.vec(), problem.vec()
         self.direction_vec, self.response_vec = problem.vec(), problem.vec()
+        self.residual_vec, self.preconditioned_vec = problem.vec(), problem.vec()
         self.g = problem.local(self.gap_vec).ravel()
         self.elastic = problem.local(self.elastic_vec).ravel()
         self.t = problem.local(self.direction_vec).ravel()
         self.response = problem.local(self.response_vec).ravel()
 
     def destroy(self):
-        for v in (self.gap_vec, self.elastic_vec, self.direction_vec, self.response_vec):
+        for v in (self.gap_vec, self.elastic_vec, self.direction_vec, self.response_vec, self.residual_vec,
+                  self.preconditioned_vec):
             v.destroy()
 
     def start_rigid(self):
@@ -131,16 +133,10 @@ class FixedSet:
         return v
 
     def precondition(self, r_free):
-        """``C r`` on F, zero mean there: one pair."""
-        work = self.problem.vec()
-        out = self.problem.vec()
-        try:
-            self.problem.local(work).ravel()[...] = r_free
-            self.problem.operator.displacement(work, out)
-            return self.on_free(self.problem.local(out, readonly=True).ravel().copy())
-        finally:
-            work.destroy()
-            out.destroy()
+        """``C r`` on F, zero mean there (a new array): one pair."""
+        self.problem.local(self.residual_vec).ravel()[...] = r_free
+        self.problem.operator.displacement(self.residual_vec, self.preconditioned_vec)
+        return self.on_free(self.problem.local(self.preconditioned_vec, readonly=True).ravel().copy())
 
     def stiffness_along(self):
         """``response = S t``: one pair."""
@@ -225,8 +221,9 @@ def oracle_cg(fixed, rtol, max_it=5000):
 
 
 def hessian_spectrum(fixed, rtol=SPECTRUM_RTOL, max_it=3000):
-    """Extreme Ritz values of C H on F at the current gap (H = S + diag(phi'')), and PCG's iterations: linear PCG
-    on H x = b, b the rigid start's gradient on F (the gap is restored)."""
+    """Extreme Ritz values of C H on F at the current gap (H = S + diag(phi'')), and PCG's iterations: the
+    coefficients of linear PCG on H x = b, b the rigid start's gradient on F (x itself is not needed; the gap is
+    restored)."""
     import pk_cascade
 
     solution = fixed.g.copy()
@@ -241,7 +238,6 @@ def hessian_spectrum(fixed, rtol=SPECTRUM_RTOL, max_it=3000):
         fixed.stiffness_along()
         return fixed.on_free(fixed.response + curvature * v)
 
-    x = np.zeros_like(b)
     r = b.copy()
     z = fixed.precondition(r)
     p = z.copy()
@@ -252,7 +248,6 @@ def hessian_spectrum(fixed, rtol=SPECTRUM_RTOL, max_it=3000):
         q = hessian(p)
         alpha = rz / float(np.dot(p, q))
         alphas.append(alpha)
-        x += alpha * p
         r -= alpha * q
         if math.sqrt(float(np.dot(r, r))) <= rtol * norm0:
             break
