@@ -260,6 +260,27 @@ def gap_step(g, t, step):
 
 
 @njit(cache=True)
+def first_breakpoint(g, t):
+    """Local ``min g_i / t_i`` over ``t_i > 0``: the step along -t at which the first gap reaches 0 (inf if none)."""
+    limit = math.inf
+    for i in range(g.size):
+        if t[i] > 0.0:
+            limit = min(limit, g[i] / t[i])
+    return limit
+
+
+@njit(cache=True)
+def close_blocking(g, t, limit):
+    """Set to 0 the gaps that reach 0 along -t by the step ``limit`` (their g_i / t_i <= limit); their count."""
+    count = 0
+    for i in range(g.size):
+        if t[i] > 0.0 and g[i] <= limit * t[i]:
+            g[i] = 0.0
+            count += 1
+    return count
+
+
+@njit(cache=True)
 def subtract_scaled(v, w, factor):
     """``v -= factor w``."""
     for i in range(v.size):

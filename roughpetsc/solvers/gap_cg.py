@@ -7,7 +7,7 @@ and an Armijo line search on the non-convex energy: docs/solvers.md.
 import numpy as np
 from petsc4py import PETSc
 
-from ..parallel import allsum
+from ..parallel import allmax, allmin, allsum
 from ..contact import loops
 from .options import python_tao
 from .protocol import Backend, Outcome
@@ -17,6 +17,8 @@ from .stopping import ConvergenceTest, History, Verdict, check_convergence, desc
 REFRESH = 50  # recompute S g at least every REFRESH iterations (the update S g -= step S t drifts)
 ARMIJO = 1e-4
 MAX_BACKTRACKS = 40
+MAX_PROJECTED_TRIALS = 8  # projected steps tried an iteration (a pair each), then steps short of the breakpoint
+BREAKPOINT_ROUNDOFF = 1e-12  # a step moving no gap by more than this times the largest gap is below round-off
 # A fall of the energy by this fraction of the work of adhesion (over the surface) since the last counts as
 # progress (it restarts the stagnation count): far above the round-off floor, where steps change the energy by
 # residual^2.
@@ -178,17 +180,22 @@ class GapCG:
         """Step the gap of ``gap_vec`` along -t by the first of ``step``, step/2, ... that lowers the energy enough;
         ``(change of the energy, whether S g was computed afresh)``, or (None, False) if no step does.
 
-        A step that crosses g = 0 is kept only if the projected gap's energy, on a fresh S g, is lower.
+        A step that crosses g = 0 is kept only if the projected gap's energy, on a fresh S g, is lower. After
+        MAX_PROJECTED_TRIALS such trials (a pair each) the step is cut to the first breakpoint, which needs no
+        projection; a breakpoint below the gaps' round-off closes the blocking gaps instead ((0.0, False)).
         """
         problem = self.problem
         elastic_vec = self.vecs[4]
         g, elastic, response = (problem.local(v).ravel() for v in (gap_vec, elastic_vec, self.vecs[1]))
+        limit, failed = 0.0, 0  # the first breakpoint, once projected steps have failed; how many have
         while True:
             step, change = _armijo_step(problem, g, t, slope, *elastic_parts, step)
             if step is None:
                 return None, False
             np.copyto(scratch.before, g)
-            if not allsum(problem.mpi, [loops.gap_step(g, t, step)])[0]:
+            crossed = allsum(problem.mpi, [loops.gap_step(g, t, step)])[0]
+            if not crossed or step <= limit:
+                np.maximum(g, 0.0, out=g)  # at the breakpoint, round-off may leave its gap at -1e-17
                 loops.subtract_scaled(elastic, response, step)
                 return change, False
             before = problem.energy(scratch.before, elastic)
@@ -200,7 +207,18 @@ class GapCG:
                 return change, True
             np.copyto(g, scratch.before)
             np.copyto(elastic, scratch.elastic)
-            step *= 0.5
+            failed += 1
+            if failed < MAX_PROJECTED_TRIALS:
+                step *= 0.5
+                continue
+            limit, = allmin(problem.mpi, [loops.first_breakpoint(g, t)])
+            largest, = allmax(problem.mpi, [np.abs(g).max(initial=0.0)])
+            if limit * allmax(problem.mpi, [np.abs(t).max(initial=0.0)])[0] <= BREAKPOINT_ROUNDOFF * largest:
+                # A step to the breakpoint is below the gaps' round-off: the line search cannot see it. The
+                # blocking gaps go into contact instead (a change at round-off, S g kept).
+                allsum(problem.mpi, [loops.close_blocking(g, t, limit)])
+                return 0.0, False
+            step = min(0.5 * step, limit)
 
 
 class GapCGBackend(Backend):
