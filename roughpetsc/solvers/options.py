@@ -1,12 +1,15 @@
 """Options of the solver objects under their prefix: scoped defaults, ``setFromOptions`` with a clear error."""
 
+import atexit
 import ctypes
 import ctypes.util
 import functools
+import gc
 import glob
 import os
 import re
 import warnings
+import weakref
 from contextlib import contextmanager
 
 from petsc4py import PETSc
@@ -231,6 +234,30 @@ class SolverOptions:
         self.given, self.replaced = {}, {}
 
 
+# The TAOs of type python not yet destroyed, in the order of their (collective) creation.
+_python_taos = []
+
+
+def _destroy_python_taos():
+    """Destroy the python TAOs a script left alive while the interpreter still runs.
+
+    petsc4py defers the destruction of a collected parallel object to PetscFinalize, which runs after the
+    interpreter has gone; a python TAO's destroy calls back into Python there and the process dies of SIGSEGV
+    at exit. Every rank destroys in reverse creation order (destroys are collective), then empties PETSc's
+    garbage of the ones already collected.
+    """
+    for reference in reversed(_python_taos):
+        tao = reference()
+        if tao is not None:
+            tao.destroy()
+    _python_taos.clear()
+    gc.collect()
+    PETSc.garbage_cleanup()
+
+
+atexit.register(_destroy_python_taos)
+
+
 def python_tao(comm, context, prefix=None):
     """A TAO of type ``python`` around ``context`` (Polonsky-Keer, the gap CG), set from the options under ``prefix``.
 
@@ -244,6 +271,8 @@ def python_tao(comm, context, prefix=None):
     tao.setType(PETSc.TAO.Type.PYTHON)
     tao.setPythonContext(context)
     tao.setMaximumIterations(DEFAULT_MAX_IT)
+    _python_taos[:] = [reference for reference in _python_taos if reference() is not None]
+    _python_taos.append(weakref.ref(tao))
 
     def cleanup():
         tao.destroy()
