@@ -2,14 +2,15 @@
 (issue 15, item 3).
 
     .venv/bin/python studies/adhesion_wave.py [--alphas 0.3 0.5] [--ranges 1 0.3 0.1 0.03 0.01]
-                                              [--sizes 2048 8192 32768] [--steps 120]
+                                              [--sizes 2048 8192 32768] [--steps 120] [--rtol 1e-10]
 
 A wave h(x) = -h cos(2 pi x / lam) (lam = 1, h = 1e-3, E* = 1) on a strip of 4 x N nodes (the wave along the
 N nodes), Johnson's parameter alpha = sqrt(2 lam w / (pi^2 E* h^2)) in ``--alphas`` (below 0.57: the surfaces do
 not jump into full contact at zero load), the Dugdale law with range h0 = w / sigma0 = ``--ranges`` x h. Each
 case is an approach from gbar = 2.2 h to 0.05 h and back under displacement control (the mean gap), ``--steps``
 each way or more, so that a step is at most half the range (a longer retraction step opens the contact beyond
-the law's reach and the path snaps off early), solved by the gap CG to a natural residual of 1e-10.
+the law's reach and the path snaps off early), solved by the gap CG to a natural residual of ``--rtol`` (1e-10;
+on 4 x 131072 nodes the FFTs' round-off floor is already 1e-10, and a path there needs 1e-9).
 
 The Tabor parameter of each case is Maugis's lambda = sigma0 (9 R / (2 pi w E*^2))^(1/3) of the wave's crest,
 R = lam^2 / (4 pi^2 h): small lambda is the DMT side, large lambda the JKR side. Compared per case:
@@ -48,7 +49,7 @@ def parameters(alpha, range_over_amplitude):
     return work, stress, stress * (9 * radius / (2 * math.pi * work * E_STAR ** 2)) ** (1 / 3)
 
 
-def run_case(n, work, stress, steps):
+def run_case(n, work, stress, steps, rtol):
     """The approach-retraction path of one case on 4 x n nodes: a list of dicts (the reason of a stop only)."""
     from roughpetsc import ContactProblem, Grid
     from roughpetsc.contact import AdhesiveProblem, approach_retraction
@@ -61,12 +62,16 @@ def run_case(n, work, stress, steps):
     gbars = approach_retraction(2.2 * AMPLITUDE, 0.05 * AMPLITUDE, steps)
     rows = []
     try:
-        for r in load_path(AdhesiveProblem(problem, Dugdale(work, stress)), gbars=gbars, rtol=1e-10):
+        for r in load_path(AdhesiveProblem(problem, Dugdale(work, stress)), gbars=gbars, rtol=rtol):
             rows.append({"gbar": float(r.gbar), "pbar": float(r.pbar), "A": float(r.A),
                          "converged": bool(r.converged), "applications": r.operator_applications,
                          "seconds": r.time_s})
             if not r.converged:
                 rows[-1]["reason"] = r.reason
+            if len(rows) % 24 == 0 or not r.converged:  # progress of a long path (hours at 131072 nodes)
+                print(f"  N = {n}, step {len(rows)} / {len(gbars)}: gbar / h {r.gbar / AMPLITUDE:.4f}, "
+                      f"pbar {r.pbar:+.4g}, {sum(row['applications'] for row in rows)} pairs, "
+                      f"{sum(row['seconds'] for row in rows):.0f} s, {r.reason}", flush=True)
         return rows
     finally:
         problem.destroy()
@@ -103,6 +108,7 @@ def main():
     parser.add_argument("--ranges", type=float, nargs="+", default=[1.0, 0.3, 0.1, 0.03, 0.01])
     parser.add_argument("--sizes", type=int, nargs="+", default=[2048, 8192, 32768])
     parser.add_argument("--steps", type=int, default=120)
+    parser.add_argument("--rtol", type=float, default=1e-10, help="natural residual of every solve")
     out = os.path.join(common.OUTPUT, "adhesion")
     args, path, cases = common.start_resumable(parser, out, "wave", "only rewrite the report from the JSON")
     for alpha in args.alphas if not args.report else ():
@@ -112,8 +118,8 @@ def main():
             for n in sorted(args.sizes):
                 if any((c["alpha"], c["range"], c["N"]) == (alpha, range_, n) for c in cases):
                     continue
-                cases.append({"alpha": alpha, "range": range_, "N": n, "steps": steps,
-                              "rows": run_case(n, work, stress, steps)})
+                cases.append({"alpha": alpha, "range": range_, "N": n, "steps": steps, "rtol": args.rtol,
+                              "rows": run_case(n, work, stress, steps, args.rtol)})
                 common.save_rows(path, cases)
                 print(alpha, range_, n, "done", flush=True)
     report(cases, out, args)
@@ -133,7 +139,7 @@ def report(cases, out, args):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    header = ["alpha", "h0 / h", "Maugis lambda", "N", "steps each way", "converged", "applications, s",
+    header = ["alpha", "h0 / h", "Maugis lambda", "N", "steps each way", "rtol", "converged", "applications, s",
               "distance to MD set",
               "pull-off / p*", "MD pull-off", "JKR pull-off", "error vs MD", "error vs JKR",
               "JKR pbar(a): max / median error", "jump-in gbar / h (JKR 1)", "snap-off gbar / h", "JKR snap-off"]
@@ -148,6 +154,7 @@ def report(cases, out, args):
             for case in group:
                 c = compare(case["rows"], work, stress, case["steps"])
                 table.append([f"{alpha:g}", f"{range_:g}", f"{lam:.2f}", case["N"], case["steps"],
+                              f"{case.get('rtol', 1e-10):g}",
                               f"{c['converged']}/{c['steps']}", cost(case["rows"]), f"{c['md_distance']:.4f}",
                               f"{c['pulloff']:.4f}",
                               f"{c['md_pulloff']:.4f}", f"{c['jkr_pulloff']:.4f}",
