@@ -270,11 +270,11 @@ def first_breakpoint(g, t):
 
 
 @njit(cache=True)
-def close_blocking(g, t, limit):
-    """Set to 0 the gaps that reach 0 along -t by the step ``limit`` (their g_i / t_i <= limit); their count."""
+def close_blocking(g, t, threshold):
+    """Set to 0 the gaps at most ``threshold`` that close along -t (t_i > 0); their count."""
     count = 0
     for i in range(g.size):
-        if t[i] > 0.0 and g[i] <= limit * t[i]:
+        if t[i] > 0.0 and g[i] <= threshold:
             g[i] = 0.0
             count += 1
     return count

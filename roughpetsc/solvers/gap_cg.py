@@ -214,9 +214,11 @@ class GapCG:
             limit, = allmin(problem.mpi, [loops.first_breakpoint(g, t)])
             largest, = allmax(problem.mpi, [np.abs(g).max(initial=0.0)])
             if limit * allmax(problem.mpi, [np.abs(t).max(initial=0.0)])[0] <= BREAKPOINT_ROUNDOFF * largest:
-                # A step to the breakpoint is below the gaps' round-off: the line search cannot see it. The
-                # blocking gaps go into contact instead (a change at round-off, S g kept).
-                allsum(problem.mpi, [loops.close_blocking(g, t, limit)])
+                # A step to the breakpoint is below the gaps' round-off: the line search cannot see it. Every
+                # gap at round-off that the direction closes goes into contact instead (a change at round-off,
+                # S g kept): a projection leaves thousands of them at 1e-17 to 1e-13, and closing only the first
+                # breakpoint's would take an iteration each.
+                allsum(problem.mpi, [loops.close_blocking(g, t, BREAKPOINT_ROUNDOFF * largest)])
                 return 0.0, False
             step = min(0.5 * step, limit)
 

@@ -33,13 +33,14 @@ def test_first_breakpoint_is_infinite_when_no_gap_closes():
     assert loops.first_breakpoint(g, -np.abs(t)) == math.inf
 
 
-def test_close_blocking_closes_exactly_the_gaps_reaching_zero_by_the_step():
+def test_close_blocking_closes_exactly_the_closing_gaps_at_or_below_the_threshold():
     g, t = random_gap_and_direction(11)
-    g[:3] = 1e-14 * t[:3] ** 2 + 1e-300  # tiny gaps closing along -t
-    t[:3] = np.abs(t[:3])
-    limit = 2e-14 * np.abs(t).max()
-    blocking = (t > 0) & (g <= limit * t)
+    g[:40] = np.geomspace(1e-17, 1e-10, 40)  # gaps at round-off and above it, half of them closing along -t
+    t[:40:2] = np.abs(t[:40:2])
+    t[1:40:2] = -np.abs(t[1:40:2])
+    threshold = 1e-12
+    blocking = (t > 0) & (g <= threshold)
     expected = np.where(blocking, 0.0, g)
-    closed = loops.close_blocking(g, t, limit)
-    assert closed == np.count_nonzero(blocking) >= 3
+    closed = loops.close_blocking(g, t, threshold)
+    assert closed == np.count_nonzero(blocking) == np.count_nonzero(np.geomspace(1e-17, 1e-10, 40)[::2] <= 1e-12)
     np.testing.assert_array_equal(g, expected)
