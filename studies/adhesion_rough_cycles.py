@@ -1,7 +1,7 @@
 """Adhesive BEM approach-retraction cycles on rough surfaces, a grid sequence, against the adhesive GW model.
 
     nice -n 10 .venv/bin/python studies/adhesion_rough_cycles.py [--group 1] [--seeds 1 ... 10]
-        [--sizes 512 1024] [--ratios 20 50 100] [--pmax 2] [--hours H] [--report]
+        [--sizes 512 1024] [--ratios 20 50 100] [--pmax 2] [--hours H] [--report] [--resolve-through STEP]
 
 Issue 36, item 4 (c)-(d). Surface: group ``--group`` of Table 7.1 (group #1 is the surface of section 6.6:
 m0^p* = 1e-4), band-limited (k_s = 64 cycles per cell), so one surface exists independently of the grid: it
@@ -171,32 +171,60 @@ def read_rows(path):
     return rows, attrs, gap
 
 
-def run_case(group_number, seed, n, ratio, pmax, rtol, protocol):
-    """Run (or resume) one cycle and write its case file."""
+def build_case(group_number, seed, n, ratio, pmax, rtol, protocol):
+    """(problem, solver, cycle, moments) of one case, before any step: the caller destroys the first two."""
     from roughpetsc import ContactProblem, Grid, fractal_group, surface_moments
-    from roughpetsc.contact import AdhesiveProblem, Dugdale, dissipated_energy
-    from roughpetsc.solvers import Solver, drive
+    from roughpetsc.contact import AdhesiveProblem, Dugdale
+    from roughpetsc.solvers import Solver
     from adhesion_chapter6 import Z0_OVER_RMS
     from grid_convergence import band_limited_surface
 
-    name = case_name(group_number, n, seed, ratio, pmax, protocol)
     group = fractal_group(group_number)
     coarse = band_limited_surface(group, seed, COARSE, COARSE)
     heights = coarse if n == COARSE else band_limited_surface(group, seed, COARSE, n)
     grid = Grid(n, n, group["length"], group["length"])
     moments = surface_moments(grid, heights, 1.0)
     rms = math.sqrt(moments["m0h"])
-    gstar_start = coarse.max() / rms + Z0_OVER_RMS + 0.2
+    cycle = Cycle(coarse.max() / rms + Z0_OVER_RMS + 0.2, pmax, protocol == "full")
+    problem = ContactProblem(grid, heights, 1.0)
+    solver = Solver(AdhesiveProblem(problem, Dugdale(Z0_OVER_RMS * rms / ratio, 1.0 / ratio)), "displacement",
+                    rtol=rtol)
+    return problem, solver, cycle, moments
+
+
+def resolve_approach(group_number, seed, n, ratio, pmax, rtol, protocol, last):
+    """Re-solve a case's approach through step ``last`` (0-based) with today's solver, printing each step's
+    certificate; no file is written. It checks a stop listed in a case file solved by an earlier solver."""
+    from roughpetsc.solvers import drive
+
+    problem, solver, cycle, _ = build_case(group_number, seed, n, ratio, pmax, rtol, protocol)
+    name = case_name(group_number, n, seed, ratio, pmax, protocol)
+    try:
+        gstars = cycle.linear[:last + 1]
+        for step, (gstar, result) in enumerate(zip(gstars, drive(solver, [("gbar", g * problem.sqrt_m0h)
+                                                                            for g in gstars]))):
+            print(f"{name} step {step} g* {gstar:.4g}: p* {result.pstar:+.4f} {result.operator_applications} "
+                  f"applications {result.time_s:.1f} s natural residual {result.kkt.natural:.2g} "
+                  f"{result.reason}", flush=True)
+    finally:
+        solver.destroy()
+        problem.destroy()
+
+
+def run_case(group_number, seed, n, ratio, pmax, rtol, protocol):
+    """Run (or resume) one cycle and write its case file."""
+    from roughpetsc.contact import dissipated_energy
+    from roughpetsc.solvers import drive
+    from adhesion_chapter6 import Z0_OVER_RMS
+
+    name = case_name(group_number, n, seed, ratio, pmax, protocol)
+    problem, solver, cycle, moments = build_case(group_number, seed, n, ratio, pmax, rtol, protocol)
     checkpoint = os.path.join(CHECKPOINTS, name + ".h5")
-    cycle = Cycle(gstar_start, pmax, protocol == "full")
     cpu_before, wall_before, gap = 0.0, 0.0, None
     if os.path.exists(checkpoint):
         cycle.rows, attrs, gap = read_rows(checkpoint)
         cycle.turn = int(attrs["turn"])
         cpu_before, wall_before = float(attrs["cpu_seconds"]), float(attrs["wall_seconds"])
-    problem = ContactProblem(grid, heights, 1.0)
-    solver = Solver(AdhesiveProblem(problem, Dugdale(Z0_OVER_RMS * rms / ratio, 1.0 / ratio)), "displacement",
-                    rtol=rtol)
     attrs = {"group": group_number, "seed": seed, "n": n, "ratio": ratio, "pmax": pmax, "rtol": rtol,
              "z0_over_rms": Z0_OVER_RMS, "protocol": protocol, "gstar_start": cycle.linear[0],
              "sqrt_m0h": problem.sqrt_m0h,
@@ -262,12 +290,24 @@ def main():
                              "lets go (both approach from out of contact)")
     parser.add_argument("--hours", type=float, default=0.0, help="start no new case after this many hours (0: none)")
     parser.add_argument("--report", action="store_true", help="only rewrite the report from the case files")
+    parser.add_argument("--resolve-through", type=int, metavar="STEP",
+                        help="only re-solve each case's approach through step STEP (0-based) with today's solver "
+                             "and print it (checks a listed stop; no file written)")
     args = parser.parse_args()
     if any(n % COARSE for n in args.sizes):
         parser.error(f"--sizes must be multiples of {COARSE} (the surfaces are generated on {COARSE}^2)")
     if not args.pmax > 0:
         parser.error("--pmax must be positive")
+    if args.resolve_through is not None and args.resolve_through < 0:
+        parser.error("--resolve-through must be a step number, 0 or more")
     common.init()
+    if args.resolve_through is not None:
+        for seed in args.seeds:
+            for n in args.sizes:
+                for ratio in args.ratios:
+                    resolve_approach(args.group, seed, n, ratio, args.pmax, args.rtol, args.protocol,
+                                     args.resolve_through)
+        return
     os.makedirs(OUT, exist_ok=True)
     if not args.report:
         started = time.perf_counter()
