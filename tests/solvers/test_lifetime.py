@@ -40,4 +40,5 @@ def test_solvers_left_alive_exit_cleanly(tmp_path, ranks):
     env = dict(os.environ, **MPI_ENV, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
     process = run_process(command, env=env, cwd=tmp_path)
     assert process.returncode == 0, process.stderr[-2000:]
-    assert process.stdout.split() == ["True", "True"] * ranks
+    # Every rank prints both results; their lines may interleave.
+    assert process.stdout.count("True") == 2 * ranks and "False" not in process.stdout, process.stdout
