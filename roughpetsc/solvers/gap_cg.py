@@ -195,7 +195,8 @@ class GapCG:
             np.copyto(scratch.before, g)
             crossed = allsum(problem.mpi, [loops.gap_step(g, t, step)])[0]
             if not crossed or step <= limit:
-                np.maximum(g, 0.0, out=g)  # at the breakpoint, round-off may leave its gap at -1e-17
+                if crossed:
+                    np.maximum(g, 0.0, out=g)  # at the breakpoint, round-off may leave its gap at -1e-17
                 loops.subtract_scaled(elastic, response, step)
                 return change, False
             before = problem.energy(scratch.before, elastic)
@@ -218,7 +219,7 @@ class GapCG:
                 # gap at round-off that the direction closes goes into contact instead (a change at round-off,
                 # S g kept): a projection leaves thousands of them at 1e-17 to 1e-13, and closing only the first
                 # breakpoint's would take an iteration each.
-                allsum(problem.mpi, [loops.close_blocking(g, t, BREAKPOINT_ROUNDOFF * largest)])
+                loops.close_blocking(g, t, BREAKPOINT_ROUNDOFF * largest)
                 return 0.0, False
             step = min(0.5 * step, limit)
 
