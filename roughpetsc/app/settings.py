@@ -44,7 +44,8 @@ PARAMETER_OPTIONS = {**{keyword: option for option, keyword in surface_options.F
                      "rtol": "kkt_rtol",
                      "tao_type": "tao_type", "pstar": "pstar", "pbar": "pbar", "gbar": "gbar",
                      "boundary": "boundary", "hardness": "hardness", "depths": "stress_depths", "nu": "nu",
-                     **{name: name for name in ("adhesion", "adhesion_work", "adhesion_stress", "adhesion_range")}}
+                     **{name: name for name in ("adhesion", "adhesion_work", "adhesion_stress", "adhesion_range",
+                                                 "adhesion_ramp")}}
 
 
 def user_message(error):

@@ -402,6 +402,57 @@ def exponential_curvature_along(gap, direction, work, range_):
     return -work / (range_ * range_) * total
 
 
+@njit(cache=True)
+def _ramp_primitive(x, width):
+    """int_0^x of the ramped Dugdale stress over sigma0, x = g - (h0 - width / 2): 1 below, falling to 0 across."""
+    if x <= 0.0:
+        return x
+    x = min(x, width)
+    return x - x * x / (2.0 * width)
+
+
+@njit(cache=True)
+def _ramp_change(gap, delta, stress, start, width):
+    """phi(gap + delta) - phi(gap) of the ramped Dugdale law: on one piece in closed form (no cancellation
+    against the gap itself, which the line search's tiny steps need), across pieces from the primitive."""
+    x, y = gap - start, gap + delta - start
+    if x <= 0.0 and y <= 0.0:
+        return stress * delta
+    if x >= width and y >= width:
+        return 0.0
+    if 0.0 < x < width and 0.0 < y < width:
+        return stress * delta * (1.0 - (x + 0.5 * delta) / width)
+    return stress * (_ramp_primitive(y, width) - _ramp_primitive(x, width))
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def ramped_dugdale_change_along(gap, direction, step, stress, start, width):
+    """Local sum of phi(g - step d) - phi(g) of the ramped Dugdale law (:func:`_ramp_change`)."""
+    total = 0.0
+    for i in range(gap.size):
+        total += _ramp_change(gap[i], -step * direction[i], stress, start, width)
+    return total
+
+
+@njit(cache=True)
+def ramped_dugdale_changes(gap, trial, stress, start, width, out):
+    """``out = phi(trial) - phi(gap)`` node by node (:func:`_ramp_change`)."""
+    for i in range(gap.size):
+        out[i] = _ramp_change(gap[i], trial[i] - gap[i], stress, start, width)
+    return out
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def ramped_dugdale_curvature_along(gap, direction, stress, start, width):
+    """Local sum of phi''(g) d^2: -sigma0 / width on the ramp, 0 off it."""
+    total = 0.0
+    for i in range(gap.size):
+        x = gap[i] - start
+        if 0.0 < x < width:
+            total += direction[i] * direction[i]
+    return -stress / width * total
+
+
 @njit(cache=True, fastmath={"reassoc"})
 def dugdale_change_along(gap, direction, step, stress, range_):
     """Local sum of phi(g - step d) - phi(g) of the Dugdale law: sigma0 (min(t, h0) - min(g, h0))."""

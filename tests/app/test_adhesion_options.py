@@ -23,6 +23,12 @@ CYCLE = ["-gbar_list", "1e-3,6e-4,3e-4,1.5e-4,3e-4,6e-4,1e-3"]
     (["-adhesion", "dugdale", "-adhesion_work", 1e-7, "-gbar", 1e-3], "-adhesion_stress: the Dugdale law needs"),
     (["-adhesion", "exponential", "-adhesion_range", 1e-5, "-gbar", 1e-3], "-adhesion_work: the work of adhesion is "
                                                                             "missing"),
+    (["-adhesion_ramp", 1e-6, "-gbar", 1e-3], "-adhesion_ramp given without -adhesion"),
+    (["-adhesion", "exponential", "-adhesion_work", 1e-7, "-adhesion_range", 1e-4, "-adhesion_ramp", 1e-6,
+      "-gbar", 1e-3], "-adhesion_ramp: the ramp belongs to the Dugdale law"),
+    (["-adhesion", "dugdale", "-adhesion_work", 1e-7, "-adhesion_range", 1e-4, "-adhesion_ramp", 3e-4,
+      "-gbar", 1e-3], "-adhesion_ramp: the ramp (0.0003) must be narrower than twice the range h0 = w / sigma0 = "
+                      "0.0001"),
 ])
 def test_adhesion_parameters_that_would_be_ignored_are_refused(tmp_path, args, named):
     out = run_cli(TINY + args, cwd=tmp_path)
@@ -32,7 +38,8 @@ def test_adhesion_parameters_that_would_be_ignored_are_refused(tmp_path, args, n
 
 @pytest.mark.parametrize("option, value, quoted", [("-adhesion_stress", 0, "got 0"),
                                                    ("-adhesion_stress", -2e-3, "got -0.002"),
-                                                   ("-adhesion_work", 0, "got 0")])
+                                                   ("-adhesion_work", 0, "got 0"),
+                                                   ("-adhesion_ramp", -1e-6, "got -1e-06")])
 def test_messages_quote_the_value_given(tmp_path, option, value, quoted):
     given = {"-adhesion_work": 1e-7, "-adhesion_stress": 1e-3, option: value}
     args = ["-adhesion", "dugdale", "-gbar", 1e-3] + [item for pair in given.items() for item in pair]
