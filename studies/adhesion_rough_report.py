@@ -684,9 +684,14 @@ def report(group=1, pmax=2.0):
     lines += ["## Pull-off and hysteresis", "",
               f"Pull-off: least p* of the retraction (within g* <= 0.6). Hysteresis: loop area int g* dp* over p* >= "
               f"{P_LO:g} (BEM) against `AdhesiveGW.dissipated_energy(p*max, {P_LO:g})` at the p*max each path "
-              "turned at (Maugis-Dugdale and JKR limit). Mean ± sd (standard error in brackets).", ""]
+              "turned at (Maugis-Dugdale and JKR limit). Mean ± sd (standard error in brackets). A 2048^2 row appears "
+              "once its cell holds every surface of 1024^2.", ""]
     rows = []
-    for (ratio, n) in grouped:
+    # A finer grid's cell joins the table once it holds every surface of the planned finest grid.
+    complete = {key: cases_ for key, cases_ in every_grid.items() if key[1] > PLANNED_FINEST
+                and {c.seed for c in cases_} >= {c.seed for c in grouped.get((key[0], PLANNED_FINEST), [])}}
+    energy.update({key: energies(complete, *key) for key in complete})
+    for (ratio, n) in sorted(list(grouped) + list(complete), key=lambda key: (key[0], key[1])):
         (pm, psd, pse, pc), edge, (am, asd, ase, ac), (mm, _, _, _), (jm, _, _, _) = energy[(ratio, n)]
         rows.append([f"1/{ratio:g}", n, pc, f"{pm:+.3f} ± {psd:.3f} ({pse:.3f})", edge,
                      f"{am:.3g} ± {asd:.2g} ({ase:.2g})", f"{mm:.3g}", f"{jm:.3g}",

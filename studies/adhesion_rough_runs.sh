@@ -20,6 +20,8 @@
 #                 their pull-off lies beyond g* = 0.6
 #   n1024_r100_b: 1024^2, surfaces 6-10 at 1/100
 #   n1024_rest  : 1024^2, surfaces 4-10 at 1/50 and 1/20
+#   full_1024   : 1024^2, full cycles at 1/100 and 1/50, 10 surfaces: the pull-off and dissipated energy on a
+#                 second grid (about 0.4-0.5 core-hours a cycle)
 #   n2048       : 2048^2, the third grid, surfaces 1-10 at 1/100, then 1/50 and 1/20 (about 33 core-hours;
 #                 resumable across sessions through its checkpoints)
 set -u
@@ -35,6 +37,7 @@ stage() {
     n1024_r50_20) run --sizes 1024 --ratios 50 20 --seeds 1 2 3 ;;
     full_512) run --protocol full --sizes 512 --ratios 100 50 --seeds $ALL ;;
     n1024_rest) run --sizes 1024 --ratios 50 20 --seeds 4 5 6 7 8 9 10 ;;
+    full_1024) run --protocol full --sizes 1024 --ratios 100 50 --seeds $ALL ;;
     n2048) run --sizes 2048 --ratios 100 --seeds $ALL && run --sizes 2048 --ratios 50 20 --seeds $ALL ;;
     *) echo "unknown stage $1" >&2; return 2 ;;
   esac
