@@ -36,8 +36,8 @@ class Dugdale:
     stress then follows where the cohesive zone ends inside its cell, instead of switching whole as the end
     crosses the node. With a ramp of 10-20 spacings' change of the gap at the surface's steepest slope, the
     pull-off of Johnson's wave is 4.8-900 times closer to Maugis-Dugdale's on the same grid (ten cases)
-    (studies/output/adhesion/wave.md). The ramp is a law of its own, close to Maugis' when narrow against h0: a
-    grid's ramp, shrunk with the spacing, converges to the same solution.
+    (studies/output/adhesion/wave.md). The ramp is a law of its own, less adhesive than Maugis' by an amount that
+    vanishes with ramp / h0; shrunk with the spacing it tends to Maugis' law as the grid is refined.
     """
 
     name = "dugdale"
