@@ -200,7 +200,7 @@ def report(cases, out, args):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    header = ["alpha", "h0 / h", "Maugis lambda", "ramp cells", "N", "steps each way", "rtol", "converged",
+    header = ["alpha", "h0 / h", "Maugis lambda", "ramp cells", "ramp / h0", "N", "steps each way", "rtol", "converged",
               "applications, s",
               "distance to MD set",
               "pull-off / p*", "MD pull-off", "JKR pull-off", "error vs MD", "error vs JKR",
@@ -216,7 +216,8 @@ def report(cases, out, args):
                            key=lambda c: (identity(c)[3], c["N"], -identity(c)[4]))
             for case in group:
                 c = compare(case["rows"], work, stress, case["steps"])
-                table.append([f"{alpha:g}", f"{range_:g}", f"{lam:.2f}", f"{identity(case)[3]:g}", case["N"],
+                table.append([f"{alpha:g}", f"{range_:g}", f"{lam:.2f}", f"{identity(case)[3]:g}",
+                              f"{ramp_width(case['N'], identity(case)[3]) / (work / stress):.3g}", case["N"],
                               case["steps"],
                               f"{case.get('rtol', 1e-10):g}",
                               f"{c['converged']}/{c['steps']}", cost(case["rows"]), f"{c['md_distance']:.4f}",
