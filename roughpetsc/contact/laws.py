@@ -36,8 +36,12 @@ class Dugdale:
     stress then follows where the cohesive zone ends inside its cell, instead of switching whole as the end
     crosses the node. With a ramp of 10-20 spacings' change of the gap at the surface's steepest slope, the
     pull-off of Johnson's wave is 4.8-900 times closer to Maugis-Dugdale's on the same grid (ten cases)
-    (studies/output/adhesion/wave.md). The ramp is a law of its own, less adhesive than Maugis' by an amount that
-    vanishes with ramp / h0; shrunk with the spacing it tends to Maugis' law as the grid is refined.
+    (studies/output/adhesion/wave.md). The ramp is a law of its own, differing from Maugis' by an amount that
+    vanishes with ramp / h0; shrunk with the spacing it tends to Maugis' law as the grid is refined. Shrunk as the
+    square root of the spacing instead (ramp / h0 proportional to h^(1/2), so that it spans more cells on a finer
+    grid), the wave's pull-off converges to Maugis-Dugdale's at first order where the step law's error falls at
+    order 0.84-0.95: at h0 = 0.03 h (Maugis lambda 12.7) it is off by 1.25, 0.51, 0.32, 0.13 and 0.053 % on
+    4096 to 65536 nodes (ramp / h0 from 1.45 to 0.36), against the step law's 1.6 % on 131072.
     """
 
     name = "dugdale"
