@@ -49,6 +49,9 @@ PLAN = (("n512", "partial", 512, (100, 50, 20), SEEDS),
         ("full_512", "full", 512, (100, 50), SEEDS),
         ("n1024_r100_b", "partial", 1024, (100,), (6, 7, 8, 9, 10)),
         ("n1024_rest", "partial", 1024, (50, 20), (4, 5, 6, 7, 8, 9, 10)))
+# The stages after the plan (issue 36, item 4 (c)-(d)): the full cycles' second grid, the partial cycles' third.
+EXTENSION = (("full_1024", "full", 1024, (100, 50), SEEDS),
+             ("n2048", "partial", 2048, (100, 50, 20), SEEDS))
 PSTARS = (0.5, 1.0, 1.5, 2.0)
 UNLOAD_PSTARS = (1.5, 1.0, 0.5)
 P_LO = 0.5
@@ -288,6 +291,35 @@ def energies(cases_by_key, ratio, n):
     return mean_sd_se(pulloff), edge, mean_sd_se(areas), mean_sd_se(model_md), mean_sd_se(model_jkr)
 
 
+def extrapolated_loops(every_grid, sizes=(512, 1024, 2048)):
+    """Rows per sigma0: the loop area over p* >= P_LO of each surface run on all three grids ``sizes`` (each
+    twice the last) fitted exactly by b + C h^p, the grid's share falling as h^p and b the converged area; the
+    mean ± sd over the surfaces of p and b, and the model against b."""
+    rows = []
+    for ratio in sorted({key[0] for key in every_grid}):
+        by_seed = {}
+        for n in sizes:
+            for c in every_grid.get((ratio, n), []):
+                by_seed.setdefault(c.seed, {})[n] = c
+        orders, limits, models = [], [], []
+        for seed, cases_ in sorted(by_seed.items()):
+            if len(cases_) < len(sizes):
+                continue
+            areas = [loop_area(cases_[n], P_LO) for n in sizes]
+            if None in areas or not (areas[0] - areas[1]) / (areas[1] - areas[2]) > 0:
+                continue
+            order = math.log((areas[0] - areas[1]) / (areas[1] - areas[2])) / math.log(2)
+            orders.append(order)
+            limits.append(areas[2] - (areas[1] - areas[2]) / (2 ** order - 1))
+            finest = cases_[sizes[-1]]
+            models.append(finest.model().dissipated_energy(float(finest.pstar[finest.turn]), P_LO))
+        if limits:
+            p, b, m = mean_sd_se(orders), mean_sd_se(limits), mean_sd_se(models)
+            rows.append([f"1/{ratio:g}", len(limits), f"{p[0]:.2f} ± {p[1]:.2f}", f"{b[0]:.3g} ± {b[1]:.2g} "
+                         f"({b[2]:.2g})", f"{m[0]:.3g}", f"{(m[0] - b[0]) / b[0]:+.0%}"])
+    return rows
+
+
 def short_approaches(cases, pmax):
     """Lines on the partial cycles whose approach turned before p*max: the contact closed, the mean gap fell below
     the protocol's smallest (``SMALLEST_GAP`` of adhesion_rough_cycles.py, where it turns too), and the mean
@@ -366,9 +398,10 @@ def checkpoints():
 def cost_per_case(cases):
     """({(protocol, N, ratio): (core-hours per case, how)}, the 1024^2 / 512^2 cost factor).
 
-    Measured where a cell has case files. A missing 1024^2 cell: its 512^2 cost times the mean 1024^2 / 512^2
-    ratio of the surfaces run on both grids (at any sigma0); a missing full-protocol cell: its partial cost times
-    the mean full / partial ratio of the surfaces run both ways."""
+    Measured where a cell has case files. A missing partial cell on N^2: its (N/2)^2 cost times the mean
+    N^2 / (N/2)^2 ratio of the surfaces run on both grids (at any sigma0); a missing full-protocol cell: its
+    partial cost times the mean full / partial ratio of the surfaces run both ways. The factor returned is
+    1024^2 / 512^2's."""
     hours = {}
     for c in cases:
         hours.setdefault((c.protocol, c.n, c.ratio), {})[c.seed] = float(c.attrs["cpu_seconds"]) / 3600
@@ -378,20 +411,23 @@ def cost_per_case(cases):
                   for seed in hours[key] if seed in hours[base]]
         return float(np.mean(values)) if values else float("nan")
 
-    grid = factor([(k, ("partial", 512, k[2])) for k in hours if k[:2] == ("partial", 1024)])
+    def grid(n):
+        return factor([(k, ("partial", n // 2, k[2])) for k in hours if k[:2] == ("partial", n)])
+
     full = factor([(k, ("partial", k[1], k[2])) for k in hours if k[0] == "full"])
     out = {key: (float(np.mean(list(v.values()))), "measured") for key, v in hours.items()}
-    for _, protocol, n, ratios, _ in PLAN:
+    for _, protocol, n, ratios, _ in PLAN + EXTENSION:
         for ratio in ratios:
             key = (protocol, n, float(ratio))
             if key in out:
                 continue
-            base = out.get(("partial", 512, float(ratio)), (float("nan"),))[0]
-            if protocol == "partial" and n == 1024:
-                out[key] = (base * grid, f"scaled: 512^2 x {grid:.1f}")
-            elif protocol == "full" and n == 512:
+            if protocol == "partial":
+                base = out.get(("partial", n // 2, float(ratio)), (float("nan"),))[0]
+                out[key] = (base * grid(n), f"scaled: {n // 2}^2 x {grid(n):.1f}")
+            else:
+                base = out.get(("partial", n, float(ratio)), (float("nan"),))[0]
                 out[key] = (base * full, f"scaled: partial x {full:.1f}")
-    return out, grid
+    return out, grid(1024)
 
 
 def status(cases):
@@ -405,7 +441,7 @@ def status(cases):
     done = sum(len(have.get((protocol, n, float(r)), set()) & set(seeds))
                for _, protocol, n, ratios, seeds in PLAN for r in ratios)
     rows, total = [], 0.0
-    for stage, protocol, n, ratios, seeds in PLAN:
+    for stage, protocol, n, ratios, seeds in PLAN + EXTENSION:
         for ratio in ratios:
             key = (protocol, n, float(ratio))
             present = sorted(have.get(key, set()) & set(seeds))
@@ -424,13 +460,14 @@ def status(cases):
                          f"{remaining:.2f}" if np.isfinite(remaining) else "-"])
     extra = sorted(k for k in have if not any(k == (protocol, n, float(r)) for _, protocol, n, ratios, _ in PLAN
                                                for r in ratios))
+    extension = {(protocol, n, float(r)): stage for stage, protocol, n, ratios, _ in EXTENSION for r in ratios}
     cpu = sum(float(c.attrs["cpu_seconds"]) for c in cases) / 3600
     wall = sum(float(c.attrs["wall_seconds"]) for c in cases) / 3600
     n1024 = {r: sorted(have.get(("partial", 1024, float(r)), set())) for r in (100, 50, 20)}
     third_grid_surfaces = "; ".join(f"{len(s)} surface{'s' if len(s) != 1 else ''} ({seed_list(sorted(s))}) at "
                                     f"1/{r:g}" for (protocol, n, r), s in sorted(have.items())
                                     if protocol == "partial" and n > PLANNED_FINEST)
-    status = (f"**All {planned} planned cycles have case files; the third grid (2048^2, outside the plan) is "
+    status = (f"**All {planned} planned cycles have case files; the third grid (2048^2, beyond the plan) is "
               f"under way.**" if done == planned else
               f"**The campaign is partial: {done} of the {planned} planned cycles have case files.**")
     lines = [f"## Status: {'the plan done, a third grid under way' if done == planned else 'a partial campaign'}", "",
@@ -441,7 +478,9 @@ def status(cases):
                                                                           -kv[0][2])):
         lines.append(f"- {protocol}, {n}^2, sigma0/E* = 1/{ratio:g}: {len(seeds)} surface"
                      f"{'s' if len(seeds) != 1 else ''} ({seed_list(sorted(seeds))})"
-                     + (" (outside the plan)" if (protocol, n, ratio) in extra else ""))
+                     + (f" (beyond the plan: stage {extension[protocol, n, ratio]})"
+                        if (protocol, n, ratio) in extension else
+                        " (outside the plan)" if (protocol, n, ratio) in extra else ""))
     lines += ["",
               "So 1024^2 has "
               + ("; ".join(f"{len(s)} surface{'s' if len(s) != 1 else ''} at 1/{r}" for r, s in n1024.items() if s)
@@ -450,14 +489,14 @@ def status(cases):
               + ("; " + " and ".join(f"1/{r}" for r, s in n1024.items() if not s) + " ha"
                  + ("s" if sum(not s for s in n1024.values()) == 1 else "ve") + " no 1024^2 run, so no grid change "
                  "is measured there" if not all(n1024.values()) else "")
-              + (f"; 2048^2, outside the plan (the n2048 stage of the runs script), has {third_grid_surfaces} "
+              + (f"; 2048^2, beyond the plan (the n2048 stage of the runs script), has {third_grid_surfaces} "
                  "(section \"The third grid\" below)" if third_grid_surfaces else
                  "; and there is **no 2048^2 run at all** (a third grid, which would give the order of "
                  "convergence, is not in the plan: about "
                  f"{costs.get(('partial', 1024, 100.0), (float('nan'),))[0] * grid_factor:.1f} core-hours a cycle "
                  "at 1/100, the 1024^2 cost scaled by the same 512^2 -> 1024^2 factor)") + "."
-              + "".join(f" A run stopped inside {h[0]} (checkpoint at step {h[1]}, {h[3] / 60:.1f} CPU minutes in, "
-                        "not committed): the resume starts there." for h in held), "",
+              + "".join(f" A run stopped inside {h[0]} (checkpoint at step {h[1]}, {h[3] / 60:.1f} CPU minutes in): "
+                        "the resume starts there." for h in held), "",
               f"Resume (every stage skips finished cases and restarts an unfinished one from its checkpoint): `{RESUME}`"
               ", or the named stages, e.g. `bash studies/adhesion_rough_runs.sh n1024_r100_a n1024_r50_20`.", "",
               "Remaining cost, in core-hours of process CPU time per case as the case files record it (measured "
@@ -466,7 +505,9 @@ def status(cases):
               "shared, so the wall time is several times the CPU time.", "",
               common.markdown_table(["stage", "protocol", "N", "sigma0/E*", "surfaces done", "missing",
                                      "core-hours per case", "core-hours left"], rows), "",
-              f"Total left: about {total:.1f} core-hours of CPU time.", ""]
+              f"Total left: about {total:.1f} core-hours of CPU time, "
+              f"{', '.join(stage for stage, *_ in EXTENSION)} included (they extend the plan: the full cycles' "
+              "second grid and the partial cycles' third).", ""]
     return lines, have
 
 
@@ -701,6 +742,16 @@ def report(group=1, pmax=2.0):
                                      "model vs BEM"], rows), "",
               "The adhesive GW model of section 6.5 has no pull-off: it is a model of nearly complete contact, a "
               "function of p* >= 0 whose cracks never coalesce, and the dissertation defines none.", ""]
+    rows = extrapolated_loops(every_grid)
+    if rows:
+        lines += ["The loop area extrapolated from three grids: each surface run on 512^2, 1024^2 and 2048^2 "
+                  "fitted exactly by b + C h^p (h the node spacing), b being its area on a converged grid. Mean ± "
+                  "sd over the surfaces (standard error of b in brackets); the model is Maugis-Dugdale's at the "
+                  "p*max the 2048^2 paths turned at. An order near 1 on every surface says the grid's share falls "
+                  "like the spacing, as the cohesive zone's end crossing nodes would make it; the extrapolation "
+                  "assumes it keeps doing so below 2048^2.", "",
+                  common.markdown_table(["sigma0/E*", "surfaces", "order p", "extrapolated loop area b", "model",
+                                         "model vs b"], rows), ""]
     if full:
         rows = []
         for (ratio, n), cycles in full.items():

@@ -21,9 +21,10 @@
 #   n1024_r100_b: 1024^2, surfaces 6-10 at 1/100
 #   n1024_rest  : 1024^2, surfaces 4-10 at 1/50 and 1/20
 #   full_1024   : 1024^2, full cycles at 1/100 and 1/50, 10 surfaces: the pull-off and dissipated energy on a
-#                 second grid (about 0.4-0.5 core-hours a cycle)
-#   n2048       : 2048^2, the third grid, surfaces 1-10 at 1/100, then 1/50 and 1/20 (about 33 core-hours;
-#                 resumable across sessions through its checkpoints)
+#                 second grid (measured 0.07-0.08 core-hours a cycle at 1/100, 0.11-0.12 at 1/50)
+#   n2048       : 2048^2, the third grid, surfaces 1-10 at 1/100, then 1/50 and 1/20 (measured 0.7-1 core-hour
+#                 a cycle at 1/100, 0.45 at 1/50; resumable across sessions through its checkpoints, whose gap
+#                 field is compressed so that the one a session ends in can be committed)
 set -u
 cd "$(dirname "$0")/.."
 source tools/env.sh
