@@ -37,6 +37,7 @@ import numpy as np
 
 import common
 from adhesion_rough_cycles import OUT, read_rows
+from grid_convergence import richardson
 
 REPORT = os.path.join(common.OUTPUT, "adhesion", "rough_cycles.md")
 RESUME = "bash studies/adhesion_rough_runs.sh > rough_runs.log 2>&1 &"
@@ -292,9 +293,10 @@ def energies(cases_by_key, ratio, n):
 
 
 def extrapolated_loops(every_grid, sizes=(512, 1024, 2048)):
-    """Rows per sigma0: the loop area over p* >= P_LO of each surface run on all three grids ``sizes`` (each
-    twice the last) fitted exactly by b + C h^p, the grid's share falling as h^p and b the converged area; the
-    mean ± sd over the surfaces of p and b, and the model against b."""
+    """Rows per sigma0: the loop area over p* >= P_LO of each surface run on all three grids ``sizes`` fitted
+    exactly by b + C h^p (grid_convergence.richardson; a surface whose changes do not shrink is left out), the
+    grid's share falling as h^p and b the converged area; the mean ± sd over the surfaces of p and b, and the
+    model against b."""
     rows = []
     for ratio in sorted({key[0] for key in every_grid}):
         by_seed = {}
@@ -306,11 +308,11 @@ def extrapolated_loops(every_grid, sizes=(512, 1024, 2048)):
             if len(cases_) < len(sizes):
                 continue
             areas = [loop_area(cases_[n], P_LO) for n in sizes]
-            if None in areas or not (areas[0] - areas[1]) / (areas[1] - areas[2]) > 0:
+            order, limit, _ = (None, None, None) if None in areas else richardson(sizes, areas)
+            if order is None:
                 continue
-            order = math.log((areas[0] - areas[1]) / (areas[1] - areas[2])) / math.log(2)
             orders.append(order)
-            limits.append(areas[2] - (areas[1] - areas[2]) / (2 ** order - 1))
+            limits.append(limit)
             finest = cases_[sizes[-1]]
             models.append(finest.model().dissipated_energy(float(finest.pstar[finest.turn]), P_LO))
         if limits:

@@ -44,6 +44,7 @@ import os
 import numpy as np
 
 import common
+from grid_convergence import richardson
 from roughpetsc.models.wavy_adhesion import WavyMaugisDugdale, jkr_mean_pressure, jkr_pulloff_displacement_control, jkr_pulloff_load_control
 
 AMPLITUDE, WAVELENGTH, E_STAR = 1e-3, 1.0, 1.0
@@ -154,6 +155,15 @@ def identity(case):
     return case["alpha"], case["range"], case["N"], case.get("ramp_cells", 0.0), case.get("rtol", 1e-10)
 
 
+def tightest_per_grid(cases):
+    """One path per grid, the one solved to the smallest residual, coarsest grid first."""
+    tightest = {}
+    for c in cases:
+        if c["N"] not in tightest or identity(c)[4] < identity(tightest[c["N"]])[4]:
+            tightest[c["N"]] = c
+    return [tightest[n] for n in sorted(tightest)]
+
+
 def order_rows(cases):
     """Per case on its second grid or finer: the pull-off's error against Maugis-Dugdale (the path's least pbar),
     its observed order in the node spacing 1 / N against the next coarser grid, and what two rates fitted to the
@@ -164,12 +174,7 @@ def order_rows(cases):
             continue
         work, stress, _ = parameters(alpha, range_)
         reference = WavyMaugisDugdale(WAVELENGTH, AMPLITUDE, E_STAR, work, stress).pulloff()[0]
-        tightest = {}  # per grid, the path solved to the smallest residual
-        for c in cases:
-            if identity(c)[:2] + identity(c)[3:4] == (alpha, range_, cells):
-                if c["N"] not in tightest or identity(c)[4] < identity(tightest[c["N"]])[4]:
-                    tightest[c["N"]] = c
-        group = [tightest[n] for n in sorted(tightest)]
+        group = tightest_per_grid(c for c in cases if identity(c)[:2] + identity(c)[3:4] == (alpha, range_, cells))
         spacing = np.array([1.0 / c["N"] for c in group])
         signed = np.array([least_pbar_error(c, reference) for c in group])
         least = np.abs(signed)
@@ -190,28 +195,6 @@ def order_rows(cases):
 def least_pbar_error(case, reference):
     """The path's pull-off (least converged pbar on retraction) over ``reference``, less 1."""
     return min(r["pbar"] for r in case["rows"][case["steps"]:] if r["converged"]) / reference - 1
-
-
-def three_grid_fit(spacing, errors):
-    """(p, b) of e(h) = b + C h^p through three grids' errors, coarsest first: p is the order of the grid's share
-    and b the error left as h -> 0 (that of the law itself). None where the differences change sign (no single
-    power fits)."""
-    from scipy.optimize import brentq
-
-    h1, h2, h3 = spacing
-    ratio = (errors[0] - errors[1]) / (errors[1] - errors[2])
-    if not ratio > 0:
-        return None
-
-    def mismatch(p):
-        return (h1 ** p - h2 ** p) / (h2 ** p - h3 ** p) - ratio
-
-    try:
-        p = brentq(mismatch, 0.05, 8.0)
-    except ValueError:
-        return None
-    c = (errors[0] - errors[1]) / (h1 ** p - h2 ** p)
-    return p, errors[2] - c * h3 ** p
 
 
 def pulloff_scatter(case, reference, window=0.1):
@@ -235,7 +218,7 @@ def ramp_sequence_rows(cases):
     """Per sequence of ramped paths whose ramp over h0 falls as h^q (q in RAMP_SCALINGS; q = 1, a fixed number of
     cells, is order_rows' 'ramp cells'), on two grids or more: each grid's pull-off error against Maugis-Dugdale,
     its scatter (pulloff_scatter), the order against the next coarser grid and, on every three consecutive grids,
-    the fit b + C h^p (three_grid_fit)."""
+    the fit b + C h^p (grid_convergence.richardson: the error's changes must shrink)."""
     rows = []
     for q, scaling in RAMP_SCALINGS.items():
         sequences = {}
@@ -243,13 +226,13 @@ def ramp_sequence_rows(cases):
             alpha, range_, n, cells, _ = identity(c)
             if cells > 0:
                 width = ramp_width(n, cells) / (range_ * AMPLITUDE)
-                sequences.setdefault((alpha, range_, float(f"{width * n ** q:.6g}")), {}).setdefault(n, []).append(c)
-        for (alpha, range_, _), grids in sorted(sequences.items()):
-            if len(grids) < (3 if q == 0 else 2):
+                sequences.setdefault((alpha, range_, float(f"{width * n ** q:.6g}")), []).append(c)
+        for (alpha, range_, _), members in sorted(sequences.items()):
+            group = tightest_per_grid(members)
+            if len(group) < (3 if q == 0 else 2):
                 continue
             work, stress, _ = parameters(alpha, range_)
             reference = WavyMaugisDugdale(WAVELENGTH, AMPLITUDE, E_STAR, work, stress).pulloff()[0]
-            group = [min(grids[n], key=lambda c: identity(c)[4]) for n in sorted(grids)]
             spacing = np.array([1.0 / c["N"] for c in group])
             signed = np.array([least_pbar_error(c, reference) for c in group])
             scatter = np.array([pulloff_scatter(c, reference) for c in group])
@@ -262,8 +245,8 @@ def ramp_sequence_rows(cases):
                     order = (f"{math.log(abs(signed[i - 1] / signed[i])) / math.log(spacing[i - 1] / spacing[i]):.2f}"
                              if readable[i - 1:i + 1].all() else "not read")
                 if i >= 2 and readable[i - 2:i + 1].all():
-                    found = three_grid_fit(spacing[i - 2:i + 1], signed[i - 2:i + 1])
-                    fit = "no single power" if found is None else f"p = {found[0]:.2f}, b = {found[1]:+.3%}"
+                    p, b, _ = richardson([c["N"] for c in group[i - 2:i + 1]], signed[i - 2:i + 1])
+                    fit = "no single power" if p is None else f"p = {p:.2f}, b = {b:+.3%}"
                 rows.append([f"{alpha:g}", f"{range_:g}", scaling,
                              f"{ramp_width(c['N'], identity(c)[3]) / (range_ * AMPLITUDE):.3f}",
                              f"{identity(c)[3]:.4g}", c["N"], f"{signed[i]:+.3%}", f"{scatter[i]:.3%}", order, fit])
@@ -364,7 +347,7 @@ def report(cases, out, args):
              "to the ramped law's own solution, not to Maugis-Dugdale's: the error is b + C h^p, b that of the law "
              "and C h^p the grid's. Falling as h^(1/2), they converge to Maugis-Dugdale's, with the law's share of "
              "the error falling as h if it goes as the square of the ramp. Each row past the second fits the three "
-             "grids up to it exactly (p, b; 'no single power' where the error's differences grow). An order is "
+             "grids up to it exactly (p, b; 'no single power' where the error's changes do not shrink with the grid). An order is "
              "'not read' where an error is within twice its scatter or 0.01 %, or above 50 %. 'Scatter' is "
              "the rms of the path's pbar about a quartic in gbar over the steps within 0.1 h of the pull-off, over "
              "Maugis-Dugdale's pull-off: the jag the contact's edge makes as it passes nodes (about ten per step on "

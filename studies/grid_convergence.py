@@ -101,16 +101,20 @@ def run(args):
 
 
 def richardson(sizes, values):
-    """(order, extrapolated value, error bar) over the three finest grids; order None if not monotone."""
+    """(order, extrapolated value, error bar) over the three finest grids, whose sizes must grow by one ratio r:
+    values[-1] + d / (r^p - 1) with d the last change; order None if not monotone."""
     if len(values) < 3:
         return None, values[-1], float("nan")
+    ratio = sizes[-1] / sizes[-2]
+    if not math.isclose(sizes[-2] / sizes[-3], ratio):
+        raise ValueError(f"Richardson extrapolation needs grids of one ratio, got {sizes[-3:]}")
     a, b, c = values[-3:]
     d1, d2 = b - a, c - b
     if d1 == 0 or d2 == 0 or np.sign(d1) != np.sign(d2) or abs(d2) >= abs(d1):
         return None, c, abs(d2)
-    order = math.log2(d1 / d2) / math.log2(sizes[-1] / sizes[-2])
-    error = abs(d2) / (2 ** order - 1)
-    return order, c + d2 / (2 ** order - 1), error
+    order = math.log(d1 / d2) / math.log(ratio)
+    error = abs(d2) / (ratio ** order - 1)
+    return order, c + d2 / (ratio ** order - 1), error
 
 
 def report():
