@@ -4,9 +4,43 @@ A field of the grid is distributed by rows (PETSc's ownership ranges, the slab o
 owns at least one row.
 """
 
+import atexit
+import gc
+import weakref
+
 import numpy as np
 
 from .errors import ParameterError
+
+# The PETSc objects with Python callbacks not yet destroyed, in the order of their (collective) creation.
+_with_callbacks = []
+
+
+def destroyed_at_exit(obj):
+    """``obj``, a PETSc object with Python callbacks or context, destroyed at exit if the script did not.
+
+    petsc4py defers the destruction of a collected parallel object to PetscFinalize, which runs after the
+    interpreter has gone; the destroy of a TAO or MATPYTHON releases its Python context and callbacks there,
+    and the process dies of SIGSEGV at exit.
+    """
+    _with_callbacks[:] = [reference for reference in _with_callbacks if reference() is not None]
+    _with_callbacks.append(weakref.ref(obj))
+    return obj
+
+
+@atexit.register
+def _destroy_objects_with_callbacks():
+    """Every rank destroys in reverse creation order (destroys are collective), then empties PETSc's garbage of
+    the ones already collected, while the interpreter still runs."""
+    from petsc4py import PETSc
+
+    for reference in reversed(_with_callbacks):
+        obj = reference()
+        if obj is not None:
+            obj.destroy()
+    _with_callbacks.clear()
+    gc.collect()
+    PETSc.garbage_cleanup()
 
 
 def _allreduce(comm, values, operation):

@@ -3,6 +3,8 @@
 import numpy as np
 from petsc4py import PETSc
 
+from ..parallel import destroyed_at_exit
+
 
 # PETSc log events (-log_view): the operator applications by kind, and every FFT pair.
 log_event = PETSc.Log.EventDecorator
@@ -78,8 +80,8 @@ class FilterOperator:
         ``context``: another MATPYTHON context on this layout (a Hessian or preconditioner made from K).
         """
         n_local = self.local_shape[0] * self.local_shape[1]
-        mat = PETSc.Mat().createPython(((n_local, self.grid.size), (n_local, self.grid.size)),
-                                       context=context or ShellContext(self), comm=self.comm)
+        mat = destroyed_at_exit(PETSc.Mat().createPython(((n_local, self.grid.size), (n_local, self.grid.size)),
+                                                         context=context or ShellContext(self), comm=self.comm))
         mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         mat.setUp()
         return mat

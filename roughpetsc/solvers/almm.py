@@ -4,7 +4,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..contact.certificate import report
-from .options import default_options, set_from_options, stop_subsolver
+from .options import default_options, set_from_options, stop_subsolver, tao_with_callbacks
 from .protocol import Backend, Outcome
 from .registry import register
 from .stopping import DEFAULT_MAX_IT, ConvergenceTest, History, describe_stop
@@ -46,8 +46,7 @@ class MeanConstrainedALMM(Backend):
         self.upper.set(PETSc.INFINITY if upper is None else upper)
         self.constraint = PETSc.Vec().createMPI((1 if comm.getRank() == 0 else 0, 1), comm=comm)
         self.jacobian = mean_jacobian(self.constraint, self.gradient, problem.n, comm)
-        tao = self.tao = PETSc.TAO().create(comm)
-        tao.setOptionsPrefix(settings.prefix)
+        tao = self.tao = tao_with_callbacks(comm, settings.prefix)
         tao.setType("almm")
         tao.setObjectiveGradient(self._objective_gradient, self.gradient)
         if hessian is not None:

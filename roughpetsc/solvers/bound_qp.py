@@ -16,7 +16,7 @@ from ..contact import loops
 from ..elastic.operator import ShellContext
 from ..errors import UserError
 from ..parallel import allmax, allmin, allsum
-from .options import _petsc_library, default_options, given_but_unusable, set_from_options
+from .options import _petsc_library, default_options, given_but_unusable, set_from_options, tao_with_callbacks
 from .preconditioner import MEAN_MODE_WEIGHT, FourierPreconditioner, FreeSetPC
 from .protocol import Backend, Outcome
 from .registry import register
@@ -413,8 +413,7 @@ class BoundQP(Backend):
         self.fourier = self.preconditioning = None
         self.initial_context = self.initial_hessian = None
         self.last = None  # (natural, load error, mean p, separation) of the last iterate tested
-        tao = self.tao = PETSc.TAO().create(problem.comm)
-        tao.setOptionsPrefix(settings.prefix)
+        tao = self.tao = tao_with_callbacks(problem.comm, settings.prefix)
         tao.setType(tao_type)
         if tao_type in KSP_TYPES and preconditioner == "fourier":
             self.fourier = self.preconditioner_type(problem)

@@ -1,20 +1,18 @@
 """Options of the solver objects under their prefix: scoped defaults, ``setFromOptions`` with a clear error."""
 
-import atexit
 import ctypes
 import ctypes.util
 import functools
-import gc
 import glob
 import os
 import re
 import warnings
-import weakref
 from contextlib import contextmanager
 
 from petsc4py import PETSc
 
 from ..errors import UserError
+from ..parallel import destroyed_at_exit
 
 
 @functools.cache
@@ -234,28 +232,11 @@ class SolverOptions:
         self.given, self.replaced = {}, {}
 
 
-# The TAOs of type python not yet destroyed, in the order of their (collective) creation.
-_python_taos = []
-
-
-def _destroy_python_taos():
-    """Destroy the python TAOs a script left alive while the interpreter still runs.
-
-    petsc4py defers the destruction of a collected parallel object to PetscFinalize, which runs after the
-    interpreter has gone; a python TAO's destroy calls back into Python there and the process dies of SIGSEGV
-    at exit. Every rank destroys in reverse creation order (destroys are collective), then empties PETSc's
-    garbage of the ones already collected.
-    """
-    for reference in reversed(_python_taos):
-        tao = reference()
-        if tao is not None:
-            tao.destroy()
-    _python_taos.clear()
-    gc.collect()
-    PETSc.garbage_cleanup()
-
-
-atexit.register(_destroy_python_taos)
+def tao_with_callbacks(comm, prefix=None):
+    """A new TAO on ``comm`` under ``prefix``, for Python callbacks: destroyed at exit if the script did not."""
+    tao = destroyed_at_exit(PETSc.TAO().create(comm))
+    tao.setOptionsPrefix(prefix)
+    return tao
 
 
 def python_tao(comm, context, prefix=None):
@@ -266,13 +247,10 @@ def python_tao(comm, context, prefix=None):
     """
     from .stopping import DEFAULT_MAX_IT
 
-    tao = PETSc.TAO().create(comm)
-    tao.setOptionsPrefix(prefix)
+    tao = tao_with_callbacks(comm, prefix)
     tao.setType(PETSc.TAO.Type.PYTHON)
     tao.setPythonContext(context)
     tao.setMaximumIterations(DEFAULT_MAX_IT)
-    _python_taos[:] = [reference for reference in _python_taos if reference() is not None]
-    _python_taos.append(weakref.ref(tao))
 
     def cleanup():
         tao.destroy()

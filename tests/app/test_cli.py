@@ -163,10 +163,10 @@ def test_non_convergence_is_reported_with_petsc_reason(tmp_path):
 @pytest.mark.mpi
 @pytest.mark.parametrize("ranks, args", [(1, SMALL + ["-pk_pc", "none", "-solve_max_time", 1e-9]),
                                          (1, SMALL + ["-tao_type", "bqnls", "-solve_max_time", 1e-9]),
-                                         (2, ["-surface_N", 256, "-surface_ks", 64, "-surface_kl", 4, "-tao_type",
-                                              "bqnls", "-kkt_rtol", 1e-13, "-solve_max_time", 0.3])])
+                                         (2, SMALL + ["-tao_type", "bqnls", "-solve_max_time", 1e-9])])
 def test_time_limit_is_reported_as_not_converged(tmp_path, ranks, args):
-    """On two ranks the limit lands mid-solve: rank 0's clock decides for both (no hang, one verdict)."""
+    """The limit is one no machine meets; a limit that lands mid-solve on two ranks is in
+    ``tests/solvers/test_time_limit.py`` (a wall-clock limit there passed whenever the machine was fast)."""
     out = run_cli(args + ["-json", tmp_path / "t.json"], ranks=ranks)
     assert out.returncode == 3, out.stderr
     step = json.load(open(tmp_path / "t.json"))["steps"][0]
