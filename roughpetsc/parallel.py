@@ -1,4 +1,5 @@
-"""MPI bookkeeping every layer shares: reductions of local sums, the split of grid rows over ranks, row exchange.
+"""MPI bookkeeping every layer shares: reductions of local sums, the split of grid rows over ranks, row exchange,
+and the collective destroy at exit of the PETSc objects with Python callbacks.
 
 A field of the grid is distributed by rows (PETSc's ownership ranges, the slab of the FFT); every rank
 owns at least one row.
