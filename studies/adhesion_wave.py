@@ -229,7 +229,7 @@ def ramp_sequence_rows(cases):
                 sequences.setdefault((alpha, range_, float(f"{width * n ** q:.6g}")), []).append(c)
         for (alpha, range_, _), members in sorted(sequences.items()):
             group = tightest_per_grid(members)
-            if len(group) < (3 if q == 0 else 2):
+            if len(group) < 2:
                 continue
             work, stress, _ = parameters(alpha, range_)
             reference = WavyMaugisDugdale(WAVELENGTH, AMPLITUDE, E_STAR, work, stress).pulloff()[0]
@@ -346,7 +346,8 @@ def report(cases, out, args):
              "over h0 is held fixed or falls as h^(1/2), so its cells grow with N. Held fixed, the paths converge "
              "to the ramped law's own solution, not to Maugis-Dugdale's: the error is b + C h^p, b that of the law "
              "and C h^p the grid's. Falling as h^(1/2), they converge to Maugis-Dugdale's, with the law's share of "
-             "the error falling as h if it goes as the square of the ramp. Each row past the second fits the three "
+             "the error falling as h if it goes as the square of the ramp. A ramp held fixed on two grids shows the "
+             "grid's share alone at that width. Each row past the second fits the three "
              "grids up to it exactly (p, b; 'no single power' where the error's changes do not shrink with the grid). An order is "
              "'not read' where an error is within twice its scatter or 0.01 %, or above 50 %. 'Scatter' is "
              "the rms of the path's pbar about a quartic in gbar over the steps within 0.1 h of the pull-off, over "
