@@ -242,9 +242,7 @@ def run_case(group_number, seed, n, ratio, pmax, rtol, protocol):
 
     try:
         if gap is not None:
-            # Resume: the checkpoint's gap (length units) is the start of the next solve, shifted to its mean gap.
-            problem.local(solver.unknown)[...] = gap[problem.local_rows] / problem.height_scale
-            solver.path.started = True
+            solver.resume(gap[problem.local_rows])  # shifted to the next mean gap by the solver
         for result in drive(solver, steps()):
             row = step_row(solver, result, requested[-1], 1 if cycle.turn < 0 else -1)
             cycle.add(row)

@@ -20,6 +20,9 @@ Maugis-Dugdale solution. A case is identified by (alpha, h0, N, C). C need not b
 with N hold the ramp at a fixed width over h0 (C proportional to N) or shrink it slower than the grid (C
 proportional to N^(1/2)); the report reads such sequences apart from those of fixed C.
 
+Finished cases are kept in wave.json and skipped on a rerun. An unfinished path writes a checkpoint (its rows
+and last gap, wave_checkpoints/) every five minutes; the same command after a kill resumes it there.
+
 The Tabor parameter of each case is Maugis's lambda = sigma0 (9 R / (2 pi w E*^2))^(1/3) of the wave's crest,
 R = lam^2 / (4 pi^2 h): small lambda is the DMT side, large lambda the JKR side. Compared per case:
 
@@ -63,21 +66,62 @@ def ramp_width(n, cells):
     return cells * (WAVELENGTH / n) * 2 * math.pi * AMPLITUDE / WAVELENGTH
 
 
-def run_case(n, work, stress, steps, rtol, cells=0.0):
-    """The approach-retraction path of one case on 4 x n nodes: a list of dicts (the reason of a stop only)."""
+CHECKPOINT_SECONDS = 300.0
+
+
+def checkpoint_path(folder, n, work, stress, cells, rtol):
+    """The checkpoint of an unfinished path (its rows so far and last gap), named by what identifies it."""
+    return os.path.join(folder, "wave_checkpoints", f"n{n}_w{work:.6e}_s{stress:.6e}_c{cells:.10g}_r{rtol:g}.h5")
+
+
+def write_checkpoint(path, rows, gap):
+    """The rows (JSON) and the gap (length units, compressed) of an unfinished path, atomically."""
+    import json
+    import h5py
+
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with h5py.File(path + ".tmp", "w") as f:
+        f.attrs["rows"] = json.dumps(rows)
+        f.create_dataset("gap", data=gap, compression="gzip", shuffle=True)
+    os.replace(path + ".tmp", path)
+
+
+def read_checkpoint(path):
+    """(rows, gap) of a checkpoint, or ([], None) when there is none."""
+    import json
+    import h5py
+
+    if not os.path.exists(path):
+        return [], None
+    with h5py.File(path, "r") as f:
+        return json.loads(f.attrs["rows"]), f["gap"][()]
+
+
+def run_case(n, work, stress, steps, rtol, cells=0.0, folder=None):
+    """The approach-retraction path of one case on 4 x n nodes: a list of dicts (the reason of a stop only).
+
+    With ``folder``, the path writes a checkpoint there every few minutes and resumes from it after a kill (a
+    path on 4 x 131072 nodes takes hours); the checkpoint is removed when the path ends.
+    """
+    import time
     from roughpetsc import ContactProblem, Grid
     from roughpetsc.contact import AdhesiveProblem, approach_retraction
-    from roughpetsc.solvers import load_path
     from roughpetsc.contact.laws import Dugdale
+    from roughpetsc.solvers import Solver, drive
     from roughpetsc.surface.generators import wave
 
     grid = Grid(4, n, 4.0 * WAVELENGTH / n, WAVELENGTH)
     problem = ContactProblem(grid, wave(grid, AMPLITUDE, WAVELENGTH), E_STAR)
     gbars = approach_retraction(2.2 * AMPLITUDE, 0.05 * AMPLITUDE, steps)
-    rows = []
+    checkpoint = checkpoint_path(folder, n, work, stress, cells, rtol) if folder else None
+    rows, gap = read_checkpoint(checkpoint) if checkpoint else ([], None)
+    solver = Solver(AdhesiveProblem(problem, Dugdale(work, stress, ramp_width(n, cells))), "displacement", rtol=rtol)
     try:
-        for r in load_path(AdhesiveProblem(problem, Dugdale(work, stress, ramp_width(n, cells))), gbars=gbars,
-                           rtol=rtol):
+        if gap is not None:
+            solver.resume(gap[problem.local_rows])
+            print(f"  N = {n}: resumed at step {len(rows)} / {len(gbars)}", flush=True)
+        saved_at = time.perf_counter()
+        for r in drive(solver, [("gbar", g) for g in gbars], first=len(rows)):
             rows.append({"gbar": float(r.gbar), "pbar": float(r.pbar), "A": float(r.A),
                          "converged": bool(r.converged), "applications": r.operator_applications,
                          "seconds": r.time_s})
@@ -87,9 +131,15 @@ def run_case(n, work, stress, steps, rtol, cells=0.0):
                 print(f"  N = {n}, step {len(rows)} / {len(gbars)}: gbar / h {r.gbar / AMPLITUDE:.4f}, "
                       f"pbar {r.pbar:+.4g}, {sum(row['applications'] for row in rows)} pairs, "
                       f"{sum(row['seconds'] for row in rows):.0f} s, {r.reason}", flush=True)
-        return rows
+            if checkpoint and time.perf_counter() - saved_at > CHECKPOINT_SECONDS and len(rows) < len(gbars):
+                write_checkpoint(checkpoint, rows, solver.fields()[1])
+                saved_at = time.perf_counter()
     finally:
+        solver.destroy()
         problem.destroy()
+    if checkpoint and os.path.exists(checkpoint):
+        os.remove(checkpoint)
+    return rows
 
 
 def compare(rows, work, stress, steps):
@@ -137,7 +187,7 @@ def main():
                     continue
                 cases.append({"alpha": alpha, "range": range_, "N": n, "steps": steps, "rtol": args.rtol,
                               "ramp_cells": args.ramp_cells,
-                              "rows": run_case(n, work, stress, steps, args.rtol, args.ramp_cells)})
+                              "rows": run_case(n, work, stress, steps, args.rtol, args.ramp_cells, out)})
                 common.save_rows(path, cases)
                 print(alpha, range_, n, args.ramp_cells, "done", flush=True)
     report(cases, out, args)

@@ -183,6 +183,12 @@ class GapContinuation:
         self.started = True
         return Guess()
 
+    def resume(self, gap):
+        """Start the next solve from ``gap`` (this rank's rows, scaled): a path taken up again from a checkpoint.
+        The solver shifts it to the next mean gap, as it shifts its own last solution."""
+        self.problem.local(self.unknown)[...] = gap
+        self.started = True
+
     def record(self, control, target, outcome, work):
         """Nothing to remember: the gap itself is the next start."""
 

@@ -135,6 +135,18 @@ class Solver:
         """This rank's rows of the pressure and gap of the last solve, in pressure and length units."""
         return self.problem.fields(self.path.unknown, self.work, self.last)
 
+    def resume(self, gap):
+        """Start the next solve from ``gap``: this rank's rows in length units, as :meth:`fields` returns them
+        (an adhesive path taken up again from a checkpoint). A pressure path restarts from its loads instead."""
+        if not hasattr(self.path, "resume"):
+            raise ParameterError("resume", f"a {self.problem.kind} path is not resumed from a gap field; only an "
+                                           "adhesive path is")
+        gap = np.asarray(gap, dtype=float)
+        local_shape = self.problem.local(self.path.unknown, readonly=True).shape
+        if gap.shape != local_shape:
+            raise ParameterError("resume", f"the gap has shape {gap.shape}, this rank's rows {local_shape}")
+        self.path.resume(gap / self.problem.height_scale)
+
     def destroy(self):
         for part in ("backend", "path"):
             if hasattr(self, part):

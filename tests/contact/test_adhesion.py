@@ -124,6 +124,46 @@ def test_approach_and_retraction_differ_and_dissipate():
     assert dissipated_energy(gbars, pbars) > 0
 
 
+def test_a_path_resumed_from_a_saved_gap_stays_on_its_branch():
+    """A retraction taken up again from the gap of its last step (a checkpoint) follows the uninterrupted path;
+    a fresh solver at the same mean gaps falls onto the approach branch, with less contact."""
+    grid, heights = sphere(64)
+    work, stress = 1e-5, 2e-2
+    gbars = (heights - heights.mean()).max() + approach_retraction(2e-3, -2e-3, 12)
+    resumed_at = 16  # four steps into the retraction, where the contact sticks
+    with adhesive_problem(grid, heights, 1.0, Dugdale(work, stress), 1e-10) as adhesive:
+        whole = list(path(adhesive, gbars))
+    with adhesive_problem(grid, heights, 1.0, Dugdale(work, stress), 1e-10) as adhesive:
+        list(path(adhesive, gbars[:resumed_at]))
+        saved = adhesive.fields()[1].copy()
+    with adhesive_problem(grid, heights, 1.0, Dugdale(work, stress), 1e-10) as adhesive:
+        adhesive.resume(saved)
+        rest = list(path(adhesive, gbars[resumed_at:]))
+    with adhesive_problem(grid, heights, 1.0, Dugdale(work, stress), 1e-10) as adhesive:
+        fresh = adhesive.solve(gbar=gbars[resumed_at])
+    assert all(r.converged for r in whole + rest + [fresh])
+    assert [r.A for r in rest] == [r.A for r in whole[resumed_at:]]
+    pbars = np.array([r.pbar for r in whole[resumed_at:]])
+    assert np.abs(np.array([r.pbar for r in rest]) - pbars).max() < 1e-8 * np.abs(pbars).max(), pbars
+    assert fresh.A < whole[resumed_at].A
+
+
+def test_resume_refuses_a_pressure_path_and_a_wrong_shape():
+    grid, heights = sphere(16)
+    problem = ContactProblem(grid, heights, 1.0, fft_effort="FFTW_ESTIMATE")
+    solvers = [Solver(problem, "load"), Solver(AdhesiveProblem(problem, Dugdale(1e-5, 2e-2)), "displacement")]
+    try:
+        for solver, shape, message in ((solvers[0], (16, 16), "only an adhesive path"),
+                                       (solvers[1], (16, 15), "shape")):
+            with pytest.raises(ParameterError, match=message) as error:
+                solver.resume(np.zeros(shape))
+            assert error.value.parameter == "resume"
+    finally:
+        for solver in solvers:
+            solver.destroy()
+        problem.destroy()
+
+
 def test_bad_parameters_name_the_option():
     grid, heights = sphere(16)
     for make, parameter in ((lambda: Dugdale(-1.0, 1.0), "adhesion_work"),
