@@ -56,13 +56,9 @@ def check(settings):
     if settings.control != "displacement":
         raise UserError(f"-{settings.load_option}: adhesive contact is solved under displacement control (it jumps "
                         "in and out of contact under load control); prescribe -gbar or -gbar_list")
-    for refused, given, why in (("resume", settings.resume,
-                                 "a resumed path restarts from its saved pressure; the adhesive problem's unknown is "
-                                 "the gap"),
-                                ("stress_depths", settings.stress_depths,
-                                 "the stresses are those of a contact pressure, not of adhesive tractions")):
-        if given:
-            raise UserError(f"-{refused} cannot be combined with -adhesion yet ({why})")
+    if settings.stress_depths:
+        raise UserError("-stress_depths cannot be combined with -adhesion yet (the stresses are those of a contact "
+                        "pressure, not of adhesive tractions)")
 
 
 def summary(law, statistics, E_star):

@@ -320,9 +320,7 @@ def solve_settings(settings, reader, comm, requests):
         record = PathRecord(summary, heights, settings.output_fields,
                             *((rows.start, rows.stop - rows.start) if distributed else ()))
         if settings.resume and os.path.exists(settings.output):
-            start = record.resume_from(settings.output, list(settings.steps), settings.load_option)
-            if start is not None:  # the next solve scales it to its load (Solver's warm start)
-                problem.local(solver.pressure)[...] = start[problem.local_rows] / problem.pressure_scale
+            start_resumed_path(settings, record, problem, solver)
         announce = functools.partial(report_interruption, settings, record)
         if comm.Get_rank() == 0 and (settings.output or settings.json):
             # Printed as soon as a signal comes: once it is, no file is replaced (StopRequests). Without
@@ -354,6 +352,28 @@ def solve_settings(settings, reader, comm, requests):
         if solver is not None:
             solver.destroy()
         problem.destroy()
+
+
+def start_resumed_path(settings, record, problem, solver):
+    """Take the steps of -output that -resume continues, and start the next solve where they end.
+
+    A contact path starts from the last saved pressure (a warm start; the solution does not depend on it). An
+    adhesive path continues from the gap of the last step taken, exactly: which branch it follows depends on
+    its history, so a file without that gap is refused rather than restarted from the rigid gap.
+    """
+    pressure, gap = record.resume_from(settings.output, list(settings.steps), settings.load_option)
+    if settings.adhesion is None:
+        if pressure is not None:  # the next solve scales it to its load (Solver's warm start)
+            problem.local(solver.pressure)[...] = pressure[problem.local_rows] / problem.pressure_scale
+        return
+    if not record.steps:
+        return  # nothing taken: the path starts afresh, from the rigid gap
+    if gap is None:
+        raise UserError(f"-resume: {settings.output} does not hold the gap of step {len(record.steps)}, the last "
+                        "one taken, and an adhesive path continues from it (its branch depends on its history). "
+                        "The gap is kept with -output_fields all, or with -output_fields last once every step "
+                        "converged")
+    solver.resume(gap[problem.local_rows])
 
 
 def say_header(settings, grid, problem, solver, statistics, summary, say):

@@ -2,13 +2,15 @@
 
 The file (:mod:`roughpetsc.store.path_file`) is rewritten atomically after the steps, so an interrupted run
 keeps its finished steps, and ``-resume`` takes those of the same problem and loads from the file and starts
-the next load from the last saved pressure.
+the next load from the last saved pressure (an adhesive path: from the gap of its last step taken).
 """
 
+import json
 import time
 
 import numpy as np
 
+from . import attribute
 from . import outputs as io
 from ..errors import UserError
 from . import path_file as load_path
@@ -101,8 +103,10 @@ class PathRecord:
         """Take from ``path`` the steps of ``loads`` it solved for the same problem.
 
         ``loads``: this run's ``(kind, value)`` of ``-load_option``; the saved loads must begin them. Steps are
-        taken up to the first that did not converge. Returns the whole pressure (pressure units) to start the
-        next load from, or None. Raises :class:`UserError` for another problem or other loads.
+        taken up to the first that did not converge. Returns ``(pressure, gap)``, whole fields (pressure and
+        length units) or None: the pressure to start the next load from (a warm start: the last saved one), and
+        the gap of the last step taken, exactly (an adhesive path continues on its branch from it). Raises
+        :class:`UserError` for another problem or other loads.
         """
         try:
             stored = load_path.read(path)
@@ -111,6 +115,8 @@ class PathRecord:
         if stored is None:
             raise UserError(f"-resume: {path} is not a roughpetsc solve output")
         differ = load_path.differs_from(stored, self.summary, RESUME_KEYS)
+        if adhesion_law(stored["attrs"].get("adhesion")) != adhesion_law(attribute(self.summary["adhesion"])):
+            differ.append("adhesion")
         if stored["heights"].shape != self.heights.shape or not np.array_equal(stored["heights"], self.heights):
             differ.insert(0, "surface")
         if differ:
@@ -118,7 +124,6 @@ class PathRecord:
                             "give another -output, or the options that made it")
         saved = [(step["summary"].get("load_option"), step["summary"].get("load_value")) for step in stored["steps"]]
         check_continuation(path, saved, loads, load_option)
-        start = stored["last_fields"].get("pressure")
         rows = slice(None) if self.first_row is None else slice(self.first_row, self.first_row + self.local_rows)
         for step in stored["steps"]:
             summary = step["summary"]
@@ -126,14 +131,25 @@ class PathRecord:
                 break
             fields = [step["fields"][name][rows] if name in step["fields"] else None for name in ("pressure", "gap")]
             self.add(summary, step["history"], *fields)
-            if "pressure" in step["fields"]:
-                start = step["fields"]["pressure"]
-        if self.keep != "none" and self.steps and len(self.steps) == len(stored["steps"]) \
-                and "pressure" in stored["last_fields"]:
+        taken = len(self.steps)
+        every_step_taken = taken == len(stored["steps"])
+        if self.keep != "none" and taken and every_step_taken and "pressure" in stored["last_fields"]:
             # Every step taken: the last fields of the file are those of the last step taken.
             self.last_fields = {name: array[rows] for name, array in stored["last_fields"].items()}
-        self.written = len(self.steps)
-        return start
+        self.written = taken
+        last_taken = stored["steps"][taken - 1]["fields"] if taken else {}
+        if not last_taken and taken and every_step_taken:
+            last_taken = stored["last_fields"]
+        pressure = last_taken.get("pressure", stored["last_fields"].get("pressure"))
+        return pressure, last_taken.get("gap")
+
+
+def adhesion_law(text):
+    """The adhesion law of a file's ``adhesion`` attribute (JSON), without what a finished cycle added to it; a
+    file from before adhesion was recorded had none."""
+    law = json.loads(text) if text else {"law": "none"}
+    law.pop("dissipated_energy", None)
+    return law
 
 
 def describe_loads(loads):

@@ -17,7 +17,7 @@ import pytest
 
 import h5py
 
-from conftest import MPI_ENV, ROOT, applications_at_time_limit, run_cli, run_process
+from conftest import MPI_ENV, ROOT, applications_at_time_limit, assert_one_clear_error, run_cli, run_process
 from roughpetsc.contact import AdhesiveProblem, approach_retraction, dissipated_energy
 from roughpetsc.solvers import Solver, drive
 from roughpetsc.contact.problem import ContactProblem
@@ -272,6 +272,53 @@ def test_command_line_cycle_reports_its_dissipated_energy(tmp_path):
         steps = [f[f"steps/{i:03d}"].attrs for i in range(5)]
         gbars, pbars = [s["gbar"] for s in steps], [s["pbar"] for s in steps]
     assert recorded == pytest.approx(dissipated_energy(gbars, pbars), rel=1e-12) and recorded > 0
+
+
+CYCLE = ["-surface_N", 48, "-surface_ks", 12, "-surface_kl", 2, "-adhesion", "exponential", "-adhesion_work", 2e-7,
+         "-adhesion_range", 2e-5, "-kkt_rtol", 1e-11, "-fft_effort", "FFTW_ESTIMATE"]
+
+
+def recorded_steps(path):
+    with h5py.File(path) as f:
+        return [dict(f[f"steps/{i:03d}"].attrs) for i in range(len(f["steps"]))]
+
+
+@pytest.mark.parametrize("ranks", [1, pytest.param(2, marks=pytest.mark.mpi)])
+def test_command_line_resume_continues_a_cycle_on_its_branch(tmp_path, ranks):
+    """-resume of an adhesive path continues from the gap of its last saved step: the retraction it solves then
+    is the uninterrupted run's, and a path started afresh at those mean gaps holds less contact."""
+    loads = "2e-4,1e-4,5e-5,1e-4,2e-4"
+    whole = run_cli(CYCLE + ["-gbar_list", loads, "-output", tmp_path / "whole.h5"])
+    part = run_cli(CYCLE + ["-gbar_list", "2e-4,1e-4,5e-5", "-output", tmp_path / "part.h5"], ranks=ranks)
+    rest = run_cli(CYCLE + ["-gbar_list", loads, "-output", tmp_path / "part.h5", "-resume"], ranks=ranks)
+    fresh = run_cli(CYCLE + ["-gbar_list", "1e-4", "-output", tmp_path / "fresh.h5"])
+    for out in (whole, part, rest, fresh):
+        assert out.returncode == 0, out.stdout + out.stderr
+    assert rest.stdout.count(f"(from {tmp_path / 'part.h5'})") == 3
+    expected, resumed = recorded_steps(tmp_path / "whole.h5"), recorded_steps(tmp_path / "part.h5")
+    assert [s["gbar"] for s in resumed] == [s["gbar"] for s in expected]
+    assert [s["A"] for s in resumed] == [s["A"] for s in expected]
+    pbars = np.array([s["pbar"] for s in expected])
+    assert np.abs(np.array([s["pbar"] for s in resumed]) - pbars).max() < 1e-8 * np.abs(pbars).max()
+    assert "energy dissipated per unit area" in rest.stdout
+    assert recorded_steps(tmp_path / "fresh.h5")[0]["A"] < expected[3]["A"]  # the approach branch
+
+
+def test_command_line_resume_of_an_adhesive_path_without_its_gap_is_refused(tmp_path):
+    part = run_cli(CYCLE + ["-gbar_list", "2e-4,1e-4", "-output", tmp_path / "part.h5", "-output_fields", "none"])
+    assert part.returncode == 0, part.stderr
+    kept = (tmp_path / "part.h5").read_bytes()
+    out = run_cli(CYCLE + ["-gbar_list", "2e-4,1e-4,5e-5", "-output", tmp_path / "part.h5", "-resume"])
+    assert_one_clear_error(out, "-resume", "part.h5", "does not hold the gap of step 2", "-output_fields all")
+    assert (tmp_path / "part.h5").read_bytes() == kept
+
+
+def test_command_line_resume_with_another_adhesion_law_is_refused(tmp_path):
+    part = run_cli(CYCLE + ["-gbar_list", "2e-4,1e-4", "-output", tmp_path / "part.h5"])
+    assert part.returncode == 0, part.stderr
+    other = [3e-7 if value == 2e-7 else value for value in CYCLE]
+    out = run_cli(other + ["-gbar_list", "2e-4,1e-4,5e-5", "-output", tmp_path / "part.h5", "-resume"])
+    assert_one_clear_error(out, "-resume", "part.h5", "another problem (different adhesion)")
 
 
 def test_tao_almm_meets_the_gap_cg():
