@@ -313,6 +313,17 @@ def test_command_line_resume_of_an_adhesive_path_without_its_gap_is_refused(tmp_
     assert (tmp_path / "part.h5").read_bytes() == kept
 
 
+def test_command_line_resume_extends_a_finished_cycle(tmp_path):
+    """A cycle's file records its dissipated energy with the law; the same law extends it all the same."""
+    cycle = run_cli(CYCLE + ["-gbar_list", "2e-4,1e-4,5e-5,2e-4", "-output", tmp_path / "c.h5"])
+    assert cycle.returncode == 0 and "energy dissipated" in cycle.stdout, cycle.stderr
+    out = run_cli(CYCLE + ["-gbar_list", "2e-4,1e-4,5e-5,2e-4,1e-4", "-output", tmp_path / "c.h5", "-resume"])
+    assert out.returncode == 0, out.stderr
+    assert [s["gbar"] for s in recorded_steps(tmp_path / "c.h5")] == [2e-4, 1e-4, 5e-5, 2e-4, 1e-4]
+    with h5py.File(tmp_path / "c.h5") as f:
+        assert "dissipated_energy" not in json.loads(f.attrs["adhesion"])  # no longer a closed cycle
+
+
 def test_command_line_resume_with_another_adhesion_law_is_refused(tmp_path):
     part = run_cli(CYCLE + ["-gbar_list", "2e-4,1e-4", "-output", tmp_path / "part.h5"])
     assert part.returncode == 0, part.stderr
