@@ -51,6 +51,10 @@ Parts (``--parts``):
   one process, each cold to 1e-8, with the load average before and after (``--rows rows_idle``).
 - ``slepc``: the Lanczos estimates checked against SLEPc (Krylov-Schur on ``B P K_CC P``, the constant on
   C deflated) at the smallest size and load given.
+- ``deflation``: what a deflation of the edge modes would need (:func:`run_deflation`): the eigenvalues of
+  ``B P K_CC P`` above 5 and 10 times its least (SLEPc, the largest ones), i.e. the size of a deflation space
+  that brings the restricted condition number to 5 or 10, the operator applications spent finding them, and
+  C's edge nodes; one row per ``--floor-pcs`` name. Small grids: at N = 256 it takes an hour here.
 - ``warm``: the load history (7.11) (95 steps) at ``--warm-n``: pairs per warm step against one cold solve
   at p* = 0.5, for today's solver (``roughpetsc.load_path``'s linear predictor) and for the prototype with
   the same predictor.
@@ -375,52 +379,125 @@ def run_projections(problem, pstar, key, rows, path, coarsest=256):
                                  median_moved=float(np.median(steps)) if steps.size else 0.0))
 
 
-def run_slepc(problem, pstar, contact, key, name, rows, path):
-    """Extreme eigenvalues of ``B P K_CC P`` on the zero-sum subspace of C by SLEPc (Krylov-Schur)."""
-    from petsc4py import PETSc
-    from slepc4py import SLEPc
-
+def restricted_operator(problem, contact, name):
+    """``(apply, count, destroy)``: x -> B P K_CC P x on the zero-sum subspace of C (vectors of C's ``count``
+    nodes), B the preconditioner ``name`` of :data:`PRECONDITIONERS`; ``destroy()`` frees its level. Each
+    application is one FFT pair (K) and the preconditioner's; ``apply.calls`` counts them."""
     import pk_cascade
 
-    n = problem.grid.n0
-    level = pk_cascade.Level(fine_heights(problem), n)
+    level = pk_cascade.Level(fine_heights(problem), problem.grid.n0)
     preconditioner = pk_cascade.make_preconditioner(level, PRECONDITIONERS[name])
     preconditioner.setup(contact)
     free = np.flatnonzero(contact)
     count = free.size
     full, response, out = np.zeros(problem.n), np.zeros(problem.n), np.zeros(problem.n)
 
+    def apply(x):
+        apply.calls += 1
+        full[...] = 0.0
+        full[free] = x
+        pk_cascade.remove_mean_on(full, contact, count)
+        level.compliance(full, response)
+        pk_cascade.remove_mean_on(response, contact, count)
+        preconditioner.apply(response, out, contact, count)
+        return out[free]
+
+    apply.calls = 0
+    return apply, count, level.destroy
+
+
+def restricted_mat(problem, contact, name):
+    """``(mat, constant, apply, destroy)``: B P K_CC P on C's nodes as a PETSc shell Mat
+    (:func:`restricted_operator`, whose ``apply`` counts its calls), the unit constant (its null vector, to
+    deflate), and ``destroy()`` for both and the level."""
+    from petsc4py import PETSc
+
+    apply, count, destroy_level = restricted_operator(problem, contact, name)
+
     class Operator:
         def mult(self, mat, x, y):
-            full[...] = 0.0
-            full[free] = x.getArray(readonly=True)
-            pk_cascade.remove_mean_on(full, contact, count)
-            level.compliance(full, response)
-            pk_cascade.remove_mean_on(response, contact, count)
-            preconditioner.apply(response, out, contact, count)
-            y.getArray()[...] = out[free]
+            y.getArray()[...] = apply(x.getArray(readonly=True))
 
     mat = PETSc.Mat().createPython((count, count), context=Operator(), comm=PETSc.COMM_SELF)
     mat.setUp()
     constant = mat.createVecLeft()
     constant.set(1.0 / np.sqrt(count))
-    values = []
-    start = time.perf_counter()
-    for which in (SLEPc.EPS.Which.SMALLEST_REAL, SLEPc.EPS.Which.LARGEST_REAL):
-        eps = SLEPc.EPS().create(PETSc.COMM_SELF)
+
+    def destroy():
+        constant.destroy()
+        mat.destroy()
+        destroy_level()
+
+    return mat, constant, apply, destroy
+
+
+def eigenvalues(mat, constant, which, nev):
+    """The ``nev`` eigenvalues (real parts) of ``mat`` at the end ``which`` (SLEPc Krylov-Schur, tolerance 1e-8,
+    ``constant`` deflated); fewer if fewer converged."""
+    from petsc4py import PETSc
+    from slepc4py import SLEPc
+
+    eps = SLEPc.EPS().create(PETSc.COMM_SELF)
+    try:
         eps.setOperators(mat)
         eps.setProblemType(SLEPc.EPS.ProblemType.NHEP)
         eps.setDeflationSpace([constant])
         eps.setWhichEigenpairs(which)
-        eps.setDimensions(nev=1, ncv=64)
+        eps.setDimensions(nev=nev, ncv=max(64, 2 * nev))
         eps.setTolerances(tol=1e-8, max_it=20000)
         eps.solve()
-        values.append(eps.getEigenvalue(0).real if eps.getConverged() else float("nan"))
+        return np.array([eps.getEigenvalue(i).real for i in range(eps.getConverged())])
+    finally:
         eps.destroy()
-    mat.destroy()
-    level.destroy()
+
+
+def run_slepc(problem, pstar, contact, key, name, rows, path):
+    """Extreme eigenvalues of ``B P K_CC P`` on the zero-sum subspace of C by SLEPc (Krylov-Schur)."""
+    from slepc4py import SLEPc
+
+    mat, constant, _, destroy = restricted_mat(problem, contact, name)
+    start = time.perf_counter()
+    try:
+        low, high = (eigenvalues(mat, constant, which, 1) for which in (SLEPc.EPS.Which.SMALLEST_REAL,
+                                                                        SLEPc.EPS.Which.LARGEST_REAL))
+    finally:
+        destroy()
+    values = [v[0] if v.size else float("nan") for v in (low, high)]
     add_row(rows, path, dict(part="slepc", key=key, variant=name, lambda_min=values[0], lambda_max=values[1],
                              cond=values[1] / values[0], seconds=time.perf_counter() - start))
+
+
+DEFLATION_CONDITIONS = (5.0, 10.0)
+
+
+def run_deflation(problem, contact, key, name, rows, path):
+    """How many eigenvectors a deflation space must hold for the restricted condition number to fall to each of
+    :data:`DEFLATION_CONDITIONS`: the eigenvalues of ``B P K_CC P`` above that many times its least (SLEPc, the
+    largest ones, doubling their number until the least found is below the first bound), against the number of
+    C's edge nodes (a 4-neighbour outside C, periodic)."""
+    from slepc4py import SLEPc
+
+    mat, constant, apply, destroy = restricted_mat(problem, contact, name)
+    start = time.perf_counter()
+    try:
+        least = eigenvalues(mat, constant, SLEPc.EPS.Which.SMALLEST_REAL, 1)[0]
+        nev = 128
+        while True:
+            largest = eigenvalues(mat, constant, SLEPc.EPS.Which.LARGEST_REAL, nev)
+            if largest.size and largest.min() <= DEFLATION_CONDITIONS[0] * least:
+                break
+            nev *= 2
+    finally:
+        destroy()
+    n = problem.grid.n0
+    inside = contact.reshape(n, n)
+    inner = np.roll(inside, 1, 0) & np.roll(inside, -1, 0) & np.roll(inside, 1, 1) & np.roll(inside, -1, 1)
+    row = dict(part="deflation", key=key, variant=name, contact=int(contact.sum()), edge=int((inside & ~inner).sum()),
+               lambda_min=float(least), lambda_max=float(largest.max()), nev=nev, applications=apply.calls,
+               seconds=time.perf_counter() - start)
+    for bound in DEFLATION_CONDITIONS:
+        row[f"above_{bound:g}"] = int(np.sum(largest > bound * least))
+    add_row(rows, path, row)
 
 
 class ExactBandPC:
@@ -820,6 +897,16 @@ def exact_band_table(rows):
                                    f"{r['cond']:.2f}", r["pairs"], r["inner_pairs"]] for r in exact])
 
 
+def deflation_table(rows):
+    found = sorted(rows_of(rows, "deflation"), key=lambda r: (parse_key(r["key"])[1], r["variant"]))
+    header = ["case", "preconditioner", "C nodes", "edge nodes", "lambda_max / lambda_min",
+              *(f"above {bound:g}x" for bound in DEFLATION_CONDITIONS), "applications"]
+    return common.markdown_table(header, [[r["key"], r["variant"], r["contact"], r["edge"],
+                                           f"{r['lambda_max'] / r['lambda_min']:.2f}",
+                                           *(r[f"above_{bound:g}"] for bound in DEFLATION_CONDITIONS),
+                                           r["applications"]] for r in found])
+
+
 def gaps_table(rows, keys):
     table = []
     for key in keys:
@@ -1056,6 +1143,12 @@ def report(rows):
               "coupling by FFT, a diagnostic only: its inner pairs are counted apart) against the band width:",
               ""]
     lines += [exact_band_table(rows) if rows_of(rows, "exactband") else "(not run)", ""]
+    if rows_of(rows, "deflation"):
+        lines += ["Deflation of the edge modes (`deflation` part): the eigenvalues of the preconditioned operator "
+                  "on C above 5 and 10 times its least, i.e. the eigenvectors a deflation space must hold for the "
+                  "restricted condition number to fall to 5 or 10, against C's edge nodes; `applications` is what "
+                  "SLEPc spent finding them (each one FFT pair and the preconditioner), against a floor of "
+                  "40-80 pairs a solve:", "", deflation_table(rows), ""]
     lines += ["## 4. Warm steps along the load history (7.11)", ""]
     lines += [warm_table(rows) if rows_of(rows, "warm") else "(not run)", ""]
     if rows_of(rows, "warmfloor"):
@@ -1197,7 +1290,7 @@ def main():
     parser.add_argument("--groups", type=int, nargs="*", default=[1, 18])
     parser.add_argument("--parts", nargs="*", default=["reference", "pk", "floor", "cold"],
                         choices=["reference", "pk", "floor", "cold", "pkcascade", "pksplit", "projections", "slepc",
-                                 "warm", "warmfloor", "exactband", "gaps", "timing"])
+                                 "warm", "warmfloor", "exactband", "gaps", "timing", "deflation"])
     parser.add_argument("--widths", type=int, nargs="*", default=[1, 2, 4, 8],
                         help="band widths of the exactband diagnostic")
     parser.add_argument("--floor-pcs", nargs="*", default=["fourier", "band2"], choices=list(PRECONDITIONERS))
@@ -1228,8 +1321,8 @@ def main():
 
 def run_case(args, group, n, pstar, rows, path):
     key = case_key(group, n, pstar)
-    todo = {part for part in args.parts if part not in ("floor", "cold", "slepc", "warm", "warmfloor", "pkcascade",
-                                                        "projections", "pksplit", "timing")
+    todo = {part for part in args.parts if part not in ("floor", "cold", "slepc", "deflation", "warm", "warmfloor",
+                                                        "pkcascade", "projections", "pksplit", "timing")
             and not has_row(rows, part, key, "pk" if part == "pk" else reference_variant(args.reference_rtol))}
     if "pkcascade" in args.parts and not has_row(rows, "cold", key, "pk-cascade"):
         todo.add("pkcascade")
@@ -1243,13 +1336,15 @@ def run_case(args, group, n, pstar, rows, path):
               and not has_row(rows, "floor", key, name, reference=args.reference_rtol)]
     colds = [name for name in args.cold if "cold" in args.parts and not has_row(rows, "cold", key, name)]
     slepcs = [name for name in args.floor_pcs if "slepc" in args.parts and not has_row(rows, "slepc", key, name)]
+    deflations = [name for name in args.floor_pcs if "deflation" in args.parts
+                  and not has_row(rows, "deflation", key, name)]
     warms = [name for name in args.warm if "warm" in args.parts and n == args.warm_n and pstar == 0.5
              and not has_row(rows, "warm", key, name)]
     warm_floors = [name for name in args.floor_pcs if "warmfloor" in args.parts and n == args.warm_n
                    and pstar == 0.5 and not has_row(rows, "warmfloor", key, name)]
     widths = [w for w in args.widths if "exactband" in args.parts and not has_row(rows, "exactband", key, f"width {w}")]
     gaps = "gaps" in args.parts and not has_row(rows, "gaps", key, "distance to C")
-    if not (todo or floors or colds or slepcs or warms or warm_floors or widths or gaps):
+    if not (todo or floors or colds or slepcs or deflations or warms or warm_floors or widths or gaps):
         return
     print(f"--- {key}", flush=True)
     problem = make_problem(group, n)
@@ -1264,7 +1359,7 @@ def run_case(args, group, n, pstar, rows, path):
             run_projections(problem, pstar, key, rows, path)
         if "timing" in todo:
             run_timing(problem, pstar, key, rows, path)
-        if floors or slepcs or widths or gaps or "reference" in todo:
+        if floors or slepcs or deflations or widths or gaps or "reference" in todo:
             contact = reference_contact(problem, pstar, args.cache, key, rows, path, args.reference_rtol)
         for name in floors:
             run_floor(problem, pstar, contact, key, name, rows, path, args.reference_rtol)
@@ -1274,6 +1369,8 @@ def run_case(args, group, n, pstar, rows, path):
             run_exact_band(problem, pstar, contact, key, width, rows, path)
         for name in slepcs:
             run_slepc(problem, pstar, contact, key, name, rows, path)
+        for name in deflations:
+            run_deflation(problem, contact, key, name, rows, path)
         for name in colds:
             run_cold(problem, pstar, key, name, rows, path)
         for name in warms:
