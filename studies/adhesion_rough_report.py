@@ -126,6 +126,14 @@ def mean_sd_se(values):
     return float(v.mean()), sd, sd / math.sqrt(v.size) if v.size > 1 else float("nan"), int(v.size)
 
 
+def spread(stats, spec, spread_spec, with_se=False):
+    """``mean ± sd (se)`` of :func:`mean_sd_se`'s ``stats`` in the given formats; the mean alone for one surface."""
+    mean, sd, se, _ = stats
+    if not np.isfinite(sd):
+        return f"{mean:{spec}}"
+    return f"{mean:{spec}} ± {sd:{spread_spec}}" + (f" ({se:{spread_spec}})" if with_se else "")
+
+
 def fmt(mean, sd=None, digits=3):
     if not np.isfinite(mean):
         return "-"
@@ -317,8 +325,8 @@ def extrapolated_loops(every_grid, sizes=(512, 1024, 2048)):
             models.append(finest.model().dissipated_energy(float(finest.pstar[finest.turn]), P_LO))
         if limits:
             p, b, m = mean_sd_se(orders), mean_sd_se(limits), mean_sd_se(models)
-            rows.append([f"1/{ratio:g}", len(limits), f"{p[0]:.2f} ± {p[1]:.2f}", f"{b[0]:.3g} ± {b[1]:.2g} "
-                         f"({b[2]:.2g})", f"{m[0]:.3g}", f"{(m[0] - b[0]) / b[0]:+.0%}"])
+            rows.append([f"1/{ratio:g}", len(limits), spread(p, ".2f", ".2f"), spread(b, ".3g", ".2g", True),
+                         f"{m[0]:.3g}", f"{(m[0] - b[0]) / b[0]:+.0%}"])
     return rows
 
 
@@ -735,9 +743,10 @@ def report(group=1, pmax=2.0):
                 and {c.seed for c in cases_} >= {c.seed for c in grouped.get((key[0], PLANNED_FINEST), [])}}
     energy.update({key: energies(complete, *key) for key in complete})
     for (ratio, n) in sorted(list(grouped) + list(complete), key=lambda key: (key[0], key[1])):
-        (pm, psd, pse, pc), edge, (am, asd, ase, ac), (mm, _, _, _), (jm, _, _, _) = energy[(ratio, n)]
-        rows.append([f"1/{ratio:g}", n, pc, f"{pm:+.3f} ± {psd:.3f} ({pse:.3f})", edge,
-                     f"{am:.3g} ± {asd:.2g} ({ase:.2g})", f"{mm:.3g}", f"{jm:.3g}",
+        pulloff, edge, area, (mm, _, _, _), (jm, _, _, _) = energy[(ratio, n)]
+        am = area[0]
+        rows.append([f"1/{ratio:g}", n, pulloff[3], spread(pulloff, "+.3f", ".3f", True), edge,
+                     spread(area, ".3g", ".2g", True), f"{mm:.3g}", f"{jm:.3g}",
                      f"{(mm - am) / am:+.0%}" if am else "-"])
     lines += [common.markdown_table(["sigma0/E*", "N", "surfaces", "BEM pull-off p*", "pull-off at the window's end",
                                      f"BEM loop area p*>={P_LO:g}", "model", "JKR-limit model",
@@ -760,8 +769,8 @@ def report(group=1, pmax=2.0):
             p = mean_sd_se([float(c.attrs["pulloff_pstar"]) for c in cycles])
             w = mean_sd_se([float(c.attrs["dissipated_energy_star"]) for c in cycles])
             let_go = sum(bool(c.attrs["let_go"]) for c in cycles)
-            rows.append([f"1/{ratio:g}", n, len(cycles), f"{p[0]:+.3f} ± {p[1]:.3f}", let_go,
-                         f"{w[0]:.3g} ± {w[1]:.2g}", f"{max(c.gstar[-1] for c in cycles):.3g}"])
+            rows.append([f"1/{ratio:g}", n, len(cycles), spread(p, "+.3f", ".3f"), let_go,
+                         spread(w, ".3g", ".2g"), f"{max(c.gstar[-1] for c in cycles):.3g}"])
         lines += ["Full protocol (retraction until the contact lets go, at most 40 steps of 0.15 beyond the start): "
                   "pull-off and the energy dissipated over the whole cycle, -closed integral p* dg* (a lower bound "
                   "where the contact has not let go: the rest of the retraction is tensile).", "",
