@@ -196,6 +196,30 @@ def test_rough_jkr_limit_is_the_maugis_dugdale_model_at_infinite_sigma0(stage):
     assert errors[-1] < 1e-4, errors
 
 
+def test_rough_jkr_limit_loading_tends_to_the_non_adhesive_model_as_w_vanishes():
+    """The rough model's JKR limit at a vanishing surface energy w = sigma0 z0: its loading curve tends to the
+    closed form (5.37)-(5.38) with the summit density (2.42), 1 - A* and g* alike, the error falling about like
+    w^(1/2) (Table 6.2 moments, z0 = 0.3 nm).
+
+    Unloading has no such limit: a JKR crack that snapped shut on loading never reopens under compression,
+    whatever w, so from p*max = 3 the non-contact area stays far below the non-adhesive curve's."""
+    p = np.array([0.5, 1.5, 3.0])
+    z0 = 3e-10
+    alpha_h = MOM[0] * MOM[2] / MOM[1] ** 2
+    errors = []
+    for s in (1e-4, 1e-6, 1e-8, 1e-10):
+        model = M.AdhesiveGW(*MOM, s, z0, crack_law="jkr")
+        A_ref, g_ref = M.complete("gw", p, model.alpha_p, alpha_h)
+        A, g = model.loading(p)
+        errors.append(max(np.max(np.abs((1 - A) / (1 - A_ref) - 1)), np.max(np.abs(g / g_ref - 1))))
+        A_unloaded, _ = model.unloading(p[:1], 3.0)
+        assert 1 - A_unloaded[0] < 0.5 * (1 - A_ref[0])
+    assert errors == sorted(errors, reverse=True), errors
+    ratios = np.array(errors[:-1]) / np.array(errors[1:])
+    assert np.all((ratios > 5) & (ratios < 20)), ratios    # a factor 100 in w: about 10 in the error
+    assert errors[-1] < 1e-3, errors
+
+
 def jkr_state(p, p_min):
     """(b*, m) of the JKR-limit crack at p* after a history minimum p_min: stable branch, or closed for good."""
     return (jkr_radius_from_polynomial(p) if p_min >= M.jkr_pmin() else 0.0), 1.0
