@@ -282,6 +282,50 @@ def extrapolated_errors(grouped, ratio, coarse, fine):
     return rows
 
 
+def three_grid_errors(every_grid, ratio, sizes=(512, 1024, 2048)):
+    """Rows (quantity, stage, p*) on the surfaces run on all three grids ``sizes``: the BEM's mean 1 - A* or g* at
+    the first passage through p* on each grid, Richardson's order p and converged value b of those means
+    (grid_convergence.richardson: None where the changes do not shrink with one sign), how many surfaces' own
+    values do so, and the model's relative error against the finest grid (mean ± sd over the surfaces) and against
+    b, as the mean model over the mean BEM (and, against 2048^2, also surface by surface, whose mean a surface with
+    a nearly closed gap can dominate). The model is the finest case's (its moments and the p*max it turned at).
+    Returns (rows, surfaces)."""
+    by_seed = {}
+    for n in sizes:
+        for c in every_grid.get((ratio, n), []):
+            by_seed.setdefault(c.seed, {})[n] = c
+    paths = [cases_ for _, cases_ in sorted(by_seed.items()) if len(cases_) == len(sizes)]
+    rows = []
+    for index, quantity in ((1, "1-A*"), (0, "g*")):
+        for stage, targets in ((+1, PSTARS), (-1, UNLOAD_PSTARS)):
+            for target in targets:
+                values, models = [], []
+                for cases_ in paths:
+                    states = [states_at_p(cases_[n], target, stage) for n in sizes]
+                    if None in states:
+                        continue
+                    finest = cases_[sizes[-1]]
+                    model = finest.model()
+                    A, g = (model.loading([target]) if stage > 0
+                            else model.unloading([target], finest.pstar[finest.turn]))
+                    values.append([state[index] for state in states])
+                    models.append(1 - A[0] if index == 1 else g[0])
+                if not values:
+                    continue
+                v, m = np.array(values), np.array(models)
+                means = v.mean(axis=0)
+                order, limit, _ = richardson(sizes, list(means))
+                shrinking = sum(richardson(sizes, list(row))[0] is not None for row in v)
+                rows.append([quantity, "approach" if stage > 0 else "retraction", f"{target:g}", len(v),
+                             *(fmt(x) for x in means), change(list(means)),
+                             f"{order:.2f}" if order is not None else "-",
+                             fmt(limit) if order is not None else "-", f"{shrinking}/{len(v)}",
+                             f"{(m.mean() - means[-1]) / means[-1]:+.0%}",
+                             fmt(*mean_sd_se((m - v[:, -1]) / v[:, -1])[:2], 2),
+                             f"{(m.mean() - limit) / limit:+.0%}" if order is not None else "-"])
+    return rows, len(paths)
+
+
 def energies(cases_by_key, ratio, n):
     """(pull-off mean, sd, se, count, count at the window's end), (loop area mean, sd, se, count), model areas."""
     cases = cases_by_key[(ratio, n)]
@@ -732,6 +776,25 @@ def report(group=1, pmax=2.0):
                           common.markdown_table(["surface", f"least p* {sizes[-2]}", f"least p* {sizes[-1]}",
                                                  f"loop area {sizes[-2]}", f"loop area {sizes[-1]}", "change"],
                                                 rows), ""]
+    three = [ratio for ratio in ratios if all((ratio, n) in every_grid for n in (512, 1024, 2048))]
+    if three:
+        lines += ["## Three grids at a fixed p*: the order, the converged value and the model against it", "",
+                  "The surfaces run on 512^2, 1024^2 and 2048^2: the BEM's mean 1 - A* and g* at the first passage "
+                  "through p* on each grid, the changes from grid to grid, Richardson's order p and converged "
+                  "value b of the three means ('-' where the changes do not shrink with one sign: no order is "
+                  "read), how many surfaces' own three values shrink so, and the model's relative error "
+                  "(model - BEM) / BEM: of the mean model against the mean on 2048^2, surface by surface against "
+                  "2048^2 (mean ± sd), and of the mean model against b. An order well below 1 extrapolates far "
+                  "beyond the grids (b then rests on the assumption that the order holds), and the 1/20 cell is "
+                  "reported on the surfaces it has.", ""]
+        for ratio in three:
+            rows, count = three_grid_errors(every_grid, ratio)
+            if not rows:
+                continue
+            lines += [f"sigma0/E* = 1/{ratio:g} ({count} surfaces):", "",
+                      common.markdown_table(["quantity", "stage", "p*", "surfaces", "BEM 512", "BEM 1024",
+                                             "BEM 2048", "change", "order p", "b", "surfaces shrinking",
+                                             "model vs 2048", "per surface vs 2048", "model vs b"], rows), ""]
     lines += ["## Pull-off and hysteresis", "",
               f"Pull-off: least p* of the retraction (within g* <= 0.6). Hysteresis: loop area int g* dp* over p* >= "
               f"{P_LO:g} (BEM) against `AdhesiveGW.dissipated_energy(p*max, {P_LO:g})` at the p*max each path "
