@@ -282,6 +282,15 @@ def extrapolated_errors(grouped, ratio, coarse, fine):
     return rows
 
 
+def surfaces_on_every_grid(every_grid, ratio, sizes):
+    """[{n: case}] of the surfaces run at ``ratio`` on every grid of ``sizes``, by seed."""
+    by_seed = {}
+    for n in sizes:
+        for c in every_grid.get((ratio, n), []):
+            by_seed.setdefault(c.seed, {})[n] = c
+    return [cases_ for _, cases_ in sorted(by_seed.items()) if len(cases_) == len(sizes)]
+
+
 def three_grid_errors(every_grid, ratio, sizes=(512, 1024, 2048)):
     """Rows (quantity, stage, p*) on the surfaces run on all three grids ``sizes``: the BEM's mean 1 - A* or g* at
     the first passage through p* on each grid, Richardson's order p and converged value b of those means
@@ -290,40 +299,36 @@ def three_grid_errors(every_grid, ratio, sizes=(512, 1024, 2048)):
     b, as the mean model over the mean BEM (and, against 2048^2, also surface by surface, whose mean a surface with
     a nearly closed gap can dominate). The model is the finest case's (its moments and the p*max it turned at).
     Returns (rows, surfaces)."""
-    by_seed = {}
-    for n in sizes:
-        for c in every_grid.get((ratio, n), []):
-            by_seed.setdefault(c.seed, {})[n] = c
-    paths = [cases_ for _, cases_ in sorted(by_seed.items()) if len(cases_) == len(sizes)]
-    rows = []
-    for index, quantity in ((1, "1-A*"), (0, "g*")):
-        for stage, targets in ((+1, PSTARS), (-1, UNLOAD_PSTARS)):
-            for target in targets:
-                values, models = [], []
-                for cases_ in paths:
-                    states = [states_at_p(cases_[n], target, stage) for n in sizes]
-                    if None in states:
-                        continue
-                    finest = cases_[sizes[-1]]
-                    model = finest.model()
-                    A, g = (model.loading([target]) if stage > 0
-                            else model.unloading([target], finest.pstar[finest.turn]))
-                    values.append([state[index] for state in states])
-                    models.append(1 - A[0] if index == 1 else g[0])
-                if not values:
+    paths = surfaces_on_every_grid(every_grid, ratio, sizes)
+    models = [cases_[sizes[-1]].model() for cases_ in paths]
+    rows = {"1-A*": [], "g*": []}
+    for stage, targets in ((+1, PSTARS), (-1, UNLOAD_PSTARS)):
+        for target in targets:
+            bem, model_values = [], []      # per surface: [(g*, 1 - A*) per grid], (g*, 1 - A*) of the model
+            for cases_, model in zip(paths, models):
+                states = [states_at_p(cases_[n], target, stage) for n in sizes]
+                if None in states:
                     continue
-                v, m = np.array(values), np.array(models)
+                finest = cases_[sizes[-1]]
+                A, g = (model.loading([target]) if stage > 0
+                        else model.unloading([target], finest.pstar[finest.turn]))
+                bem.append([state[:2] for state in states])
+                model_values.append((g[0], 1 - A[0]))
+            if not bem:
+                continue
+            for index, quantity in ((1, "1-A*"), (0, "g*")):
+                v, m = np.array(bem)[:, :, index], np.array(model_values)[:, index]
                 means = v.mean(axis=0)
                 order, limit, _ = richardson(sizes, list(means))
                 shrinking = sum(richardson(sizes, list(row))[0] is not None for row in v)
-                rows.append([quantity, "approach" if stage > 0 else "retraction", f"{target:g}", len(v),
-                             *(fmt(x) for x in means), change(list(means)),
-                             f"{order:.2f}" if order is not None else "-",
-                             fmt(limit) if order is not None else "-", f"{shrinking}/{len(v)}",
-                             f"{(m.mean() - means[-1]) / means[-1]:+.0%}",
-                             fmt(*mean_sd_se((m - v[:, -1]) / v[:, -1])[:2], 2),
-                             f"{(m.mean() - limit) / limit:+.0%}" if order is not None else "-"])
-    return rows, len(paths)
+                rows[quantity].append([quantity, "approach" if stage > 0 else "retraction", f"{target:g}", len(v),
+                                       *(fmt(x) for x in means), change(list(means)),
+                                       f"{order:.2f}" if order is not None else "-",
+                                       fmt(limit) if order is not None else "-", f"{shrinking}/{len(v)}",
+                                       f"{(m.mean() - means[-1]) / means[-1]:+.0%}",
+                                       fmt(*mean_sd_se((m - v[:, -1]) / v[:, -1])[:2], 2),
+                                       f"{(m.mean() - limit) / limit:+.0%}" if order is not None else "-"])
+    return rows["1-A*"] + rows["g*"], len(paths)
 
 
 def energies(cases_by_key, ratio, n):
@@ -351,14 +356,8 @@ def extrapolated_loops(every_grid, sizes=(512, 1024, 2048)):
     model against b."""
     rows = []
     for ratio in sorted({key[0] for key in every_grid}):
-        by_seed = {}
-        for n in sizes:
-            for c in every_grid.get((ratio, n), []):
-                by_seed.setdefault(c.seed, {})[n] = c
         orders, limits, models = [], [], []
-        for seed, cases_ in sorted(by_seed.items()):
-            if len(cases_) < len(sizes):
-                continue
+        for cases_ in surfaces_on_every_grid(every_grid, ratio, sizes):
             areas = [loop_area(cases_[n], P_LO) for n in sizes]
             order, limit, _ = (None, None, None) if None in areas else richardson(sizes, areas)
             if order is None:
